@@ -1,0 +1,254 @@
+"""The rig file: a body hung from wires, read from TOML and checked before any physics runs.
+
+Units are SI and angles radians. Vectors named ``anchor`` are in the world frame (z up, gravity along
+-z); ``attach`` and ``com`` are in the body frame, whose origin and axes the file chooses freely; the
+inertia tensor is about the centre of mass along the body axes. Wire 1 is the first ``[[wire]]`` in
+the file, everywhere in this project.
+
+Every problem is raised as :class:`RigError`, which names the file, the field and what is wrong, so
+that the command line can print it as one line and exit with status 2.
+"""
+
+from __future__ import annotations
+
+import math
+import tomllib
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+
+import numpy as np
+
+
+class RigError(ValueError):
+    """A rig that cannot be used: ``source: field: problem``."""
+
+    def __init__(self, source: str, field_name: str, problem: str):
+        self.source, self.field, self.problem = source, field_name, problem
+        super().__init__(f"{source}: {field_name}: {problem}")
+
+
+@dataclass(frozen=True)
+class Wire:
+    """An inextensible massless wire from a ceiling ``anchor`` (world, m) to ``attach`` (body, m)."""
+
+    anchor: np.ndarray
+    attach: np.ndarray
+    length: float
+
+
+@dataclass(frozen=True)
+class Uncertainty:
+    """Standard deviations of measured rig quantities (m, kg, s); zero where not stated."""
+
+    length: float = 0.0
+    anchor: float = 0.0
+    attach: float = 0.0
+    mass: float = 0.0
+    com: float = 0.0
+    period: float = 0.0
+
+
+@dataclass(frozen=True)
+class Rig:
+    """A rigid body hung from wires, with an optional initial disturbance from its rest pose."""
+
+    name: str
+    mass: float
+    inertia: np.ndarray  # 3x3 about the COM, body axes, kg m^2
+    wires: tuple[Wire, ...]
+    com: np.ndarray = field(default_factory=lambda: np.zeros(3))  # body frame, m
+    gravity: float = 9.81  # m/s^2, along world -z
+    initial_rotation: np.ndarray = field(default_factory=lambda: np.zeros(3))  # rad, world frame
+    initial_omega: np.ndarray = field(default_factory=lambda: np.zeros(3))  # rad/s, world frame
+    uncertainty: Uncertainty = field(default_factory=Uncertainty)
+    source: str = "<memory>"
+
+    def with_initial(self, rotation=(0.0, 0.0, 0.0), omega=(0.0, 0.0, 0.0)) -> "Rig":
+        """The same rig with another initial disturbance (rotation vector and angular velocity)."""
+        return replace(
+            self,
+            initial_rotation=np.asarray(rotation, dtype=float),
+            initial_omega=np.asarray(omega, dtype=float),
+        )
+
+
+_TOP_KEYS = {"name", "gravity", "body", "wire", "initial", "uncertainty"}
+_BODY_KEYS = {"mass", "com", "inertia"}
+_WIRE_KEYS = {"anchor", "attach", "length"}
+_INITIAL_KEYS = {"rotation", "omega"}
+_UNCERTAINTY_KEYS = set(Uncertainty.__dataclass_fields__)
+
+
+def load_rig(path: str | Path) -> Rig:
+    """Read and check a rig file; raise :class:`RigError` on any problem."""
+    path = Path(path)
+    src = str(path)
+    try:
+        text = path.read_text()
+    except OSError as exc:
+        raise RigError(src, "file", f"cannot read ({exc.strerror})") from None
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise RigError(src, "toml", f"not valid TOML ({exc})") from None
+    return rig_from_dict(data, source=src, default_name=path.stem)
+
+
+def rig_from_dict(data: dict, source: str = "<memory>", default_name: str = "rig") -> Rig:
+    """Build a checked :class:`Rig` from the parsed TOML table (see the module docstring)."""
+    _no_unknown(data, _TOP_KEYS, source, "")
+    name = data.get("name", default_name)
+    if not isinstance(name, str) or not name:
+        raise RigError(source, "name", "must be a non-empty string")
+    gravity = _positive(data.get("gravity", 9.81), source, "gravity")
+
+    body = _table(data, "body", source, required=True)
+    _no_unknown(body, _BODY_KEYS, source, "body.")
+    mass = _positive(_required(body, "mass", source, "body."), source, "body.mass")
+    com = _vector(body.get("com", [0.0, 0.0, 0.0]), source, "body.com")
+    inertia = _inertia(_required(body, "inertia", source, "body."), source)
+
+    wires_raw = data.get("wire")
+    if not isinstance(wires_raw, list) or not all(isinstance(w, dict) for w in wires_raw):
+        raise RigError(source, "wire", "missing: give the wires as [[wire]] tables")
+    if len(wires_raw) < 2:
+        raise RigError(source, "wire", f"two [[wire]] tables needed, found {len(wires_raw)}")
+    wires = []
+    for i, w in enumerate(wires_raw, start=1):
+        prefix = f"wire[{i}]."
+        _no_unknown(w, _WIRE_KEYS, source, prefix)
+        wires.append(
+            Wire(
+                anchor=_vector(_required(w, "anchor", source, prefix), source, prefix + "anchor"),
+                attach=_vector(_required(w, "attach", source, prefix), source, prefix + "attach"),
+                length=_positive(_required(w, "length", source, prefix), source, prefix + "length"),
+            )
+        )
+
+    initial = _table(data, "initial", source, required=False)
+    _no_unknown(initial, _INITIAL_KEYS, source, "initial.")
+    rotation = _vector(initial.get("rotation", [0.0, 0.0, 0.0]), source, "initial.rotation")
+    omega = _vector(initial.get("omega", [0.0, 0.0, 0.0]), source, "initial.omega")
+
+    unc_raw = _table(data, "uncertainty", source, required=False)
+    _no_unknown(unc_raw, _UNCERTAINTY_KEYS, source, "uncertainty.")
+    unc = Uncertainty(
+        **{k: _non_negative(v, source, f"uncertainty.{k}") for k, v in unc_raw.items()}
+    )
+
+    rig = Rig(
+        name=name,
+        mass=mass,
+        inertia=inertia,
+        wires=tuple(wires),
+        com=com,
+        gravity=gravity,
+        initial_rotation=rotation,
+        initial_omega=omega,
+        uncertainty=unc,
+        source=source,
+    )
+    check_reachable(rig)
+    return rig
+
+
+def check_reachable(rig: Rig) -> None:
+    """Raise unless the two wires, the anchor span and the attachment span can close a loop.
+
+    The loop anchor A -> attach -> attach -> anchor B is a quadrilateral with sides |AB|, l, b', l';
+    a taut pose exists only if no side is longer than the sum of the other three, and the body
+    needs two distinct attachment points to be held by two wires.
+    """
+    w1, w2 = rig.wires[0], rig.wires[1]
+    span_top = float(np.linalg.norm(w1.anchor - w2.anchor))
+    span_body = float(np.linalg.norm(w1.attach - w2.attach))
+    if span_body < 1e-9:
+        raise RigError(rig.source, "wire[2].attach", "coincides with wire[1].attach; the body would hang from one point")
+    sides = {"anchor span": span_top, "wire[1].length": w1.length,
+             "attachment span": span_body, "wire[2].length": w2.length}
+    total = sum(sides.values())
+    for label, side in sides.items():
+        if side > total - side:
+            raise RigError(
+                rig.source,
+                "wire",
+                f"no taut pose: the {label} ({side:.6g} m) exceeds the sum of the other three "
+                f"sides of the anchor-wire-body loop ({total - side:.6g} m)",
+            )
+
+
+def _required(table: dict, key: str, source: str, prefix: str):
+    if key not in table:
+        raise RigError(source, prefix + key, "missing")
+    return table[key]
+
+
+def _table(data: dict, key: str, source: str, required: bool) -> dict:
+    value = data.get(key)
+    if value is None:
+        if required:
+            raise RigError(source, key, "missing: give a [" + key + "] table")
+        return {}
+    if not isinstance(value, dict):
+        raise RigError(source, key, "must be a table")
+    return value
+
+
+def _no_unknown(table: dict, allowed: set, source: str, prefix: str) -> None:
+    unknown = sorted(set(table) - allowed)
+    if unknown:
+        raise RigError(source, prefix + unknown[0], f"unknown key (allowed: {', '.join(sorted(allowed))})")
+
+
+def _number(value, source: str, name: str) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise RigError(source, name, f"must be a number, got {type(value).__name__}")
+    if not math.isfinite(value):
+        raise RigError(source, name, f"must be finite, got {value}")
+    return float(value)
+
+
+def _positive(value, source: str, name: str) -> float:
+    x = _number(value, source, name)
+    if x <= 0.0:
+        raise RigError(source, name, f"must be positive, got {x:g}")
+    return x
+
+
+def _non_negative(value, source: str, name: str) -> float:
+    x = _number(value, source, name)
+    if x < 0.0:
+        raise RigError(source, name, f"must be non-negative, got {x:g}")
+    return x
+
+
+def _vector(value, source: str, name: str) -> np.ndarray:
+    if not isinstance(value, list) or len(value) != 3:
+        raise RigError(source, name, "must be a list of three numbers")
+    return np.array([_number(v, source, f"{name}[{i}]") for i, v in enumerate(value)])
+
+
+def _inertia(value, source: str) -> np.ndarray:
+    name = "body.inertia"
+    if isinstance(value, list) and len(value) == 3 and all(isinstance(r, list) for r in value):
+        rows = [_vector(r, source, f"{name}[{i}]") for i, r in enumerate(value)]
+        tensor = np.array(rows)
+        if not np.allclose(tensor, tensor.T, rtol=1e-12, atol=1e-12 * np.abs(tensor).max()):
+            raise RigError(source, name, "is not symmetric")
+    elif isinstance(value, list) and len(value) == 3:
+        tensor = np.diag(_vector(value, source, name))
+    else:
+        raise RigError(source, name, "must be three principal moments or a symmetric 3x3 matrix")
+    moments = np.linalg.eigvalsh(tensor)
+    if moments[0] <= 0.0:
+        raise RigError(source, name, f"is not positive definite (eigenvalues {_fmt(moments)})")
+    # A real body has I_a + I_b >= I_c for its principal moments; allow rounding in the last digit.
+    if moments[0] + moments[1] < moments[2] * (1.0 - 1e-9):
+        raise RigError(
+            source, name, f"breaks the triangle inequality I1 + I2 >= I3 (principal moments {_fmt(moments)})"
+        )
+    return 0.5 * (tensor + tensor.T)
+
+
+def _fmt(values) -> str:
+    return "[" + ", ".join(f"{v:.6g}" for v in values) + "]"

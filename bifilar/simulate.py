@@ -1,0 +1,186 @@
+"""Integrate the Kane-Tseng equations from a rigid-body state, switching wire charts as needed.
+
+The state vector is (theta, theta') in the current chart of wire 1's direction. Integration uses
+scipy's DOP853 (8th order, dense output of order 7), which reaches the 1e-10 relative tolerances the
+cross-checks need in few steps. Three terminal events stop a segment:
+
+* the chart degenerates (POLAR: sin(theta2) < 0.1, TILT: |u . n1| > 0.95); the state is converted
+  through the pose to the other chart and integration resumes, so hysteresis prevents chattering;
+* a wire's tension reaches zero: the taut-wire model no longer holds, and the run ends there with
+  ``slack`` saying which wire went slack and when (the model never integrates a pushing wire).
+
+Outputs are sampled on a uniform grid from the dense output, never from the integrator's own steps.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.integrate import solve_ivp
+
+from . import kane_kernel as K
+from .kane import POLAR, TILT, KaneModel, wire_angles
+from .statics import State
+
+_ENTER_TILT = 0.1  # leave POLAR when sin(theta2) falls below this
+_ENTER_POLAR = 0.95  # leave TILT when |u . n1| rises above this
+_START_POLAR = 0.2  # start in POLAR when sin(theta2) is at least this
+
+
+@dataclass(frozen=True)
+class KaneRun:
+    """A sampled Kane trajectory; every vector is in the world frame, every angle in the thesis's
+    POLAR chart (theta3 is arbitrary where theta2 = 0)."""
+
+    t: np.ndarray  # s, (n,)
+    theta: np.ndarray  # rad, (n, 5)
+    com: np.ndarray  # m, (n, 3)
+    rotation: np.ndarray  # body -> world, (n, 3, 3)
+    velocity: np.ndarray  # m/s, (n, 3)
+    omega: np.ndarray  # rad/s, (n, 3)
+    tension: np.ndarray  # N, (n, 2)
+    length_error: np.ndarray  # m, (n, 2)
+    energy: np.ndarray  # J, (n,)
+    chart: np.ndarray  # chart used at each sample, (n,)
+    nfev: int  # right-hand-side evaluations
+    slack: tuple[int, float] | None  # (wire number, time) where a wire went slack, else None
+
+
+def state_to_chart(model: KaneModel, state: State, chart: int) -> np.ndarray:
+    """(theta, theta') of a rigid-body state in the given chart."""
+    theta = model.angles(state.com, state.rotation, chart)
+    return np.concatenate([theta, model.rates(theta, state.velocity, state.omega, chart)])
+
+
+def preferred_chart(model: KaneModel, state: State) -> int:
+    """POLAR unless wire 1 hangs within ~11.5 degrees of the vertical."""
+    theta = model.angles(state.com, state.rotation, POLAR)
+    return POLAR if np.sin(theta[1]) >= _START_POLAR else TILT
+
+
+def simulate(
+    model: KaneModel,
+    state: State,
+    duration: float,
+    dt_out: float = 0.01,
+    rtol: float = 1e-10,
+    atol: float | None = None,
+) -> KaneRun:
+    """Integrate from ``state`` for ``duration`` seconds, sampling every ``dt_out`` seconds."""
+    atol = 1e-2 * rtol if atol is None else atol
+    n_out = int(np.floor(duration / dt_out + 1e-9)) + 1
+    grid = np.arange(n_out) * dt_out
+    p = model.p
+    chart = preferred_chart(model, state)
+    y = state_to_chart(model, state, chart)
+    t0 = 0.0
+    samples, charts = [], []
+    nfev = 0
+    slack = None
+    while True:
+        events = [_chart_event(chart), _slack_event(p, chart, 0), _slack_event(p, chart, 1)]
+        todo = grid[(grid >= t0) & (grid <= duration)]
+        if samples:
+            todo = todo[todo > t0]
+        sol = solve_ivp(
+            lambda t, yy, c=chart: K.rhs(yy, p, c),
+            (t0, duration),
+            y,
+            method="DOP853",
+            t_eval=todo,
+            rtol=rtol,
+            atol=atol,
+            events=events,
+        )
+        nfev += sol.nfev
+        if sol.status == -1:
+            raise RuntimeError(f"kane integration failed at t = {sol.t[-1] if sol.t.size else t0}: {sol.message}")
+        if sol.y.shape[1]:
+            samples.append((sol.y.T, chart))
+            charts.append(np.full(sol.y.shape[1], chart))
+        if sol.status == 0:
+            break
+        t_event = sol.t_events
+        if t_event[1].size or t_event[2].size:
+            wire = 1 if t_event[1].size else 2
+            slack = (wire, float(t_event[wire][0]))
+            break
+        # Chart boundary: go through the pose to the other chart and carry on.
+        t0 = float(t_event[0][0])
+        y_event = sol.y_events[0][0]
+        pose_state = _state_of(model, y_event, chart)
+        chart = TILT if chart == POLAR else POLAR
+        y = state_to_chart(model, pose_state, chart)
+    return _sampled_run(model, samples, grid, nfev, slack)
+
+
+def _state_of(model: KaneModel, y: np.ndarray, chart: int) -> State:
+    com, rotation = model.pose(y[:5], chart)
+    velocity, omega = model.velocity(y[:5], y[5:], chart)
+    return State(com=com, rotation=rotation, velocity=velocity, omega=omega)
+
+
+def _chart_event(chart: int):
+    if chart == POLAR:
+        def event(t, y):
+            return np.sin(y[1]) - _ENTER_TILT
+    else:
+        def event(t, y):
+            return _ENTER_POLAR - abs(np.sin(y[2]))
+    event.terminal, event.direction = True, -1
+    return event
+
+
+def _slack_event(p: np.ndarray, chart: int, wire: int):
+    def event(t, y):
+        return K.loads(y[:5], y[5:], p, chart)[0][wire]
+    event.terminal, event.direction = True, -1
+    return event
+
+
+def _sampled_run(model, samples, grid, nfev, slack) -> KaneRun:
+    parts = {k: [] for k in ("theta", "com", "rotation", "velocity", "omega", "tension", "energy", "chart")}
+    for Y, chart in samples:
+        Y = np.ascontiguousarray(Y)
+        com, frames, vel, omg, tension, _, energy = K.observe(Y, model.p, chart)
+        theta = Y[:, :5].copy()
+        if chart == TILT:
+            for i in range(len(theta)):
+                u = K.wire_direction(theta[i, 1], theta[i, 2], TILT)[0]
+                theta[i, 1:3] = wire_angles(u, POLAR)
+        parts["theta"].append(theta)
+        parts["com"].append(com)
+        parts["rotation"].append(frames @ model.frame_in_body.T)
+        parts["velocity"].append(vel)
+        parts["omega"].append(omg)
+        parts["tension"].append(tension)
+        parts["energy"].append(energy)
+        parts["chart"].append(np.full(len(Y), chart))
+    cat = {k: np.concatenate(v) for k, v in parts.items()}
+    n = len(cat["energy"])
+    length_error = _length_errors(model, cat["com"], cat["rotation"])
+    return KaneRun(
+        t=grid[:n],
+        theta=cat["theta"],
+        com=cat["com"],
+        rotation=cat["rotation"],
+        velocity=cat["velocity"],
+        omega=cat["omega"],
+        tension=cat["tension"],
+        length_error=length_error,
+        energy=cat["energy"],
+        chart=cat["chart"],
+        nfev=nfev,
+        slack=slack,
+    )
+
+
+def _length_errors(model: KaneModel, com: np.ndarray, rotation: np.ndarray) -> np.ndarray:
+    """|anchor - attachment| - length per sample and wire (m), from the pose alone."""
+    rig = model.rig
+    out = np.empty((len(com), len(rig.wires)))
+    for j, w in enumerate(rig.wires):
+        pts = com + rotation @ (w.attach - rig.com)
+        out[:, j] = np.linalg.norm(pts - w.anchor, axis=1) - w.length
+    return out

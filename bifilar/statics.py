@@ -1,0 +1,180 @@
+"""Engine-neutral statics of a rig: its rest pose, static wire tensions and initial state.
+
+A pose is the COM position ``com`` (world frame, m) and the rotation matrix ``rotation`` (body frame to
+world frame). Both engines start from :func:`initial_state`, so that they integrate the same motion:
+
+1. the rest pose: the minimum of the potential ``m g z_com`` with every wire at its length, polished
+   by Newton's method on the equilibrium equations (force and moment balance, wire lengths), whose
+   unknowns include the tensions;
+2. the body rotated about its COM by ``rig.initial_rotation`` (rotation vector, world frame);
+3. the COM moved by the shortest displacement that makes both wires exactly their length;
+4. angular velocity ``rig.initial_omega`` (world frame) and the smallest COM velocity that keeps both
+   wire lengths constant.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.optimize import least_squares, minimize
+from scipy.spatial.transform import Rotation
+
+from .rig import Rig, RigError
+
+
+@dataclass(frozen=True)
+class State:
+    """Rigid-body state: COM position and velocity (world, m and m/s), body->world rotation, and
+    angular velocity (world, rad/s)."""
+
+    com: np.ndarray
+    rotation: np.ndarray
+    velocity: np.ndarray
+    omega: np.ndarray
+
+
+@dataclass(frozen=True)
+class Rest:
+    """The rest pose and the static tension of each wire (N, positive when pulling)."""
+
+    com: np.ndarray
+    rotation: np.ndarray
+    tensions: np.ndarray
+
+
+def attachments(rig: Rig, com: np.ndarray, rotation: np.ndarray) -> np.ndarray:
+    """World positions (n_wires x 3, m) of the attachment points for a pose."""
+    arms = np.array([w.attach - rig.com for w in rig.wires])
+    return com + arms @ rotation.T
+
+
+def anchors(rig: Rig) -> np.ndarray:
+    """World positions (n_wires x 3, m) of the ceiling anchors."""
+    return np.array([w.anchor for w in rig.wires])
+
+
+def lengths(rig: Rig) -> np.ndarray:
+    """Wire lengths (m)."""
+    return np.array([w.length for w in rig.wires])
+
+
+def length_errors(rig: Rig, com: np.ndarray, rotation: np.ndarray) -> np.ndarray:
+    """Anchor-to-attachment distance minus wire length, per wire (m)."""
+    return np.linalg.norm(attachments(rig, com, rotation) - anchors(rig), axis=1) - lengths(rig)
+
+
+def _equilibrium_residual(x: np.ndarray, rig: Rig, rotation0: np.ndarray, scale: float) -> np.ndarray:
+    """Force balance, moment balance about the COM and wire lengths, each made dimensionless."""
+    n = len(rig.wires)
+    com, rotation = x[:3], Rotation.from_rotvec(x[3:6]).as_matrix() @ rotation0
+    tension = x[6 : 6 + n] * rig.mass * rig.gravity
+    pts = attachments(rig, com, rotation)
+    span = anchors(rig) - pts
+    dist = np.linalg.norm(span, axis=1)
+    pull = span / dist[:, None] * tension[:, None]
+    force = pull.sum(axis=0) - np.array([0.0, 0.0, rig.mass * rig.gravity])
+    moment = np.cross(pts - com, pull).sum(axis=0)
+    weight = rig.mass * rig.gravity
+    return np.concatenate([force / weight, moment / (weight * scale), (dist - lengths(rig)) / scale])
+
+
+def rest_pose(rig: Rig) -> Rest:
+    """The stable rest pose and static tensions, to machine precision.
+
+    Raises :class:`RigError` if no pose holds both wires taut (a wire would have to push).
+    """
+    scale = float(max(lengths(rig).max(), np.ptp(anchors(rig), axis=0).max(), 1e-3))
+    rotation0 = np.eye(3)
+    guess = anchors(rig).mean(axis=0) - np.array([0.0, 0.0, lengths(rig).mean()])
+    guess = guess - (np.array([w.attach for w in rig.wires]).mean(axis=0) - rig.com)
+    com0 = guess + taut_shift(rig, guess, rotation0)
+
+    def potential(x):
+        return x[2] / scale
+
+    def wire_lengths(x):
+        rot = Rotation.from_rotvec(x[3:6]).as_matrix() @ rotation0
+        return length_errors(rig, x[:3], rot) / scale
+
+    coarse = minimize(
+        potential,
+        np.concatenate([com0, np.zeros(3)]),
+        method="SLSQP",
+        constraints=[{"type": "eq", "fun": wire_lengths}],
+        options={"ftol": 1e-12, "maxiter": 500},
+    )
+    x = coarse.x
+    rotation0 = Rotation.from_rotvec(x[3:6]).as_matrix() @ rotation0
+    com = x[:3]
+    # Tension guess from force balance alone, then Newton on the full equilibrium equations.
+    span = anchors(rig) - attachments(rig, com, rotation0)
+    dirs = span / np.linalg.norm(span, axis=1)[:, None]
+    t0 = np.linalg.lstsq(dirs.T, np.array([0.0, 0.0, 1.0]), rcond=None)[0]
+    sol = least_squares(
+        _equilibrium_residual,
+        np.concatenate([com, np.zeros(3), t0]),
+        args=(rig, rotation0, scale),
+        method="lm",
+        xtol=1e-15,
+        ftol=1e-15,
+        gtol=1e-15,
+    )
+    residual = float(np.abs(sol.fun).max())
+    if residual > 1e-9:
+        raise RigError(rig.source, "wire", f"no equilibrium with every wire taut (residual {residual:.2e})")
+    rotation = Rotation.from_rotvec(sol.x[3:6]).as_matrix() @ rotation0
+    tensions = sol.x[6:] * rig.mass * rig.gravity
+    slack = np.flatnonzero(tensions <= 0.0)
+    if slack.size:
+        i = int(slack[0])
+        raise RigError(
+            rig.source,
+            f"wire[{i + 1}]",
+            f"would be slack at rest (tension {tensions[i]:.6g} N): the body cannot hang taut on every wire",
+        )
+    return Rest(com=sol.x[:3].copy(), rotation=rotation, tensions=tensions)
+
+
+def taut_shift(rig: Rig, com: np.ndarray, rotation: np.ndarray) -> np.ndarray:
+    """The shortest COM displacement (world, m) that puts both wires at their lengths.
+
+    Each wire confines the displaced COM to a sphere; the two spheres meet in a circle, and the
+    answer is the point of that circle nearest the current COM.
+    """
+    if len(rig.wires) != 2:
+        raise RigError(rig.source, "wire", f"the initial state is defined for two wires, found {len(rig.wires)}")
+    # Sphere i: displacement d with |d - c_i| = L_i.
+    centres = anchors(rig) - attachments(rig, com, rotation)
+    radii = lengths(rig)
+    axis = centres[1] - centres[0]
+    dist = float(np.linalg.norm(axis))
+    if dist < 1e-12:
+        raise RigError(rig.source, "wire", "both wires run between the same pair of points")
+    axis /= dist
+    along = (dist**2 + radii[0] ** 2 - radii[1] ** 2) / (2.0 * dist)
+    radius2 = radii[0] ** 2 - along**2
+    if radius2 < 0.0:
+        raise RigError(rig.source, "wire", "no taut pose for this orientation: the wires cannot both reach")
+    centre = centres[0] + along * axis
+    off = -centre - np.dot(-centre, axis) * axis
+    norm = float(np.linalg.norm(off))
+    if norm < 1e-12:  # every point of the circle is equally near: take any
+        off = np.cross(axis, [1.0, 0.0, 0.0] if abs(axis[0]) < 0.9 else [0.0, 1.0, 0.0])
+        norm = float(np.linalg.norm(off))
+    return centre + np.sqrt(radius2) * off / norm
+
+
+def initial_state(rig: Rig, rest: Rest | None = None) -> State:
+    """The rig's initial state, exactly as the rig file's ``[initial]`` table defines it."""
+    rest = rest_pose(rig) if rest is None else rest
+    rotation = Rotation.from_rotvec(rig.initial_rotation).as_matrix() @ rest.rotation
+    com = rest.com + taut_shift(rig, rest.com, rotation)
+    omega = np.asarray(rig.initial_omega, dtype=float)
+    pts = attachments(rig, com, rotation)
+    span = pts - anchors(rig)
+    dirs = span / np.linalg.norm(span, axis=1)[:, None]
+    # Wire i keeps its length iff dirs_i . (v + omega x arm_i) = 0; take the least-norm v.
+    rate = np.einsum("ij,ij->i", dirs, np.cross(omega, pts - com))
+    velocity = -np.linalg.pinv(dirs) @ rate
+    return State(com=com, rotation=rotation, velocity=velocity, omega=omega)
