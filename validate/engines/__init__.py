@@ -1,0 +1,26 @@
+"""Engines: each turns a rig into an engine-neutral :class:`~validate.trajectory.Trajectory`.
+
+Every engine starts from :func:`bifilar.statics.initial_state` (the rig file's ``[initial]``
+semantics) and returns the rig channels of :data:`validate.trajectory.RIG_CHANNELS` plus
+``velocity`` and ``omega`` (world frame) and ``energy`` (J, zero potential at z = 0).
+An engine is ``run(rig, duration, dt_out, rtol) -> Trajectory``; ``rtol`` is the integrator's
+relative tolerance where the engine has one and is ignored otherwise.
+"""
+
+from __future__ import annotations
+
+from typing import Callable
+
+from bifilar.rig import Rig
+
+from ..trajectory import Trajectory
+
+EngineRun = Callable[[Rig, float, float, float], Trajectory]
+
+
+def engines() -> dict[str, EngineRun]:
+    """Engine name -> run function (imported lazily so that one engine's import cost is paid only
+    when it is used)."""
+    from . import kane, mujoco_rig
+
+    return {"kane": kane.run, **mujoco_rig.ENGINES}

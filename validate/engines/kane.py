@@ -1,0 +1,36 @@
+"""The hand-derived Kane-Tseng model as an engine (:mod:`bifilar.simulate`)."""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+from bifilar.kane import KaneModel
+from bifilar.rig import Rig
+from bifilar.simulate import KaneRun, simulate
+from bifilar.statics import initial_state
+
+from ..trajectory import Trajectory
+
+
+def run(rig: Rig, duration: float, dt_out: float = 0.01, rtol: float = 1e-10) -> Trajectory:
+    """Integrate the rig's initial state; see :func:`bifilar.simulate.simulate`."""
+    model = KaneModel.from_rig(rig)
+    return to_trajectory(simulate(model, initial_state(rig), duration, dt_out=dt_out, rtol=rtol), rig, rtol)
+
+
+def to_trajectory(kr: KaneRun, rig: Rig, rtol: float) -> Trajectory:
+    quat = Rotation.from_matrix(kr.rotation).as_quat(scalar_first=True)
+    quat *= np.where(quat[:, :1] < 0.0, -1.0, 1.0)  # one hemisphere: qw >= 0
+    channels = {
+        "com": kr.com,
+        "quat": quat,
+        "tension": kr.tension,
+        "length_error": kr.length_error,
+        "velocity": kr.velocity,
+        "omega": kr.omega,
+        "energy": kr.energy,
+        "theta": kr.theta,
+    }
+    meta = {"rig": rig.name, "rtol": rtol, "nfev": kr.nfev, "slack": kr.slack}
+    return Trajectory("kane", kr.t, channels, meta)
