@@ -17,6 +17,7 @@ import numpy as np
 
 from . import kane_kernel as K
 from .rig import Rig, RigError
+from .statics import State
 
 POLAR, TILT = K.POLAR, K.TILT
 
@@ -118,6 +119,12 @@ class KaneModel:
         kin = K.kinematics(_vec(theta), _vec(dtheta), self.p, chart)
         V, G = kin[3], kin[4]
         return V @ dtheta, G @ dtheta
+
+    def state(self, theta, dtheta, chart=POLAR) -> State:
+        """The rigid-body state (world frame) of angles and rates."""
+        com, rotation = self.pose(theta, chart)
+        velocity, omega = self.velocity(theta, dtheta, chart)
+        return State(com=com, rotation=rotation, velocity=velocity, omega=omega)
 
     def angles(self, com, rotation, chart=POLAR) -> np.ndarray:
         """The five angles of a pose (the pose must hold both wires at their lengths)."""

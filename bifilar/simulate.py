@@ -109,16 +109,10 @@ def simulate(
         # Chart boundary: go through the pose to the other chart and carry on.
         t0 = float(t_event[0][0])
         y_event = sol.y_events[0][0]
-        pose_state = _state_of(model, y_event, chart)
+        pose_state = model.state(y_event[:5], y_event[5:], chart)
         chart = TILT if chart == POLAR else POLAR
         y = state_to_chart(model, pose_state, chart)
     return _sampled_run(model, samples, grid, nfev, slack)
-
-
-def _state_of(model: KaneModel, y: np.ndarray, chart: int) -> State:
-    com, rotation = model.pose(y[:5], chart)
-    velocity, omega = model.velocity(y[:5], y[5:], chart)
-    return State(com=com, rotation=rotation, velocity=velocity, omega=omega)
 
 
 def _chart_event(chart: int):

@@ -149,8 +149,12 @@ def taut_shift(rig: Rig, com: np.ndarray, rotation: np.ndarray) -> np.ndarray:
     radii = lengths(rig)
     axis = centres[1] - centres[0]
     dist = float(np.linalg.norm(axis))
-    if dist < 1e-12:
-        raise RigError(rig.source, "wire", "both wires run between the same pair of points")
+    if dist < 1e-12 * radii.max():
+        # Parallel, equal wires: the spheres coincide; take the nearest point of the one sphere.
+        if abs(radii[0] - radii[1]) > 1e-12 * radii.max():
+            raise RigError(rig.source, "wire", "no taut pose for this orientation: the wires cannot both reach")
+        norm = float(np.linalg.norm(centres[0]))
+        return centres[0] - radii[0] * centres[0] / norm if norm > 0.0 else np.array([0.0, 0.0, -radii[0]])
     axis /= dist
     along = (dist**2 + radii[0] ** 2 - radii[1] ** 2) / (2.0 * dist)
     radius2 = radii[0] ** 2 - along**2

@@ -1,0 +1,161 @@
+"""``python -m validate``: run the validation suite, and the rig tools it is built on.
+
+Exit status: 0 success, 1 a validation check failed, 2 bad input (one line on stderr naming the
+file, the field and the problem), 3 the Kane model's taut-wire assumption failed during a run.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import sys
+from pathlib import Path
+
+from bifilar.rig import RigError, load_rig
+
+
+class UsageError(Exception):
+    """Bad command-line input; printed as one line, exit status 2."""
+
+
+class _Parser(argparse.ArgumentParser):
+    def error(self, message):  # one line instead of usage + message
+        raise UsageError(f"{self.prog}: {message}")
+
+
+def _positive_float(name: str):
+    def parse(text: str) -> float:
+        try:
+            value = float(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{name} must be a number, got {text!r}") from None
+        if not math.isfinite(value) or value <= 0.0:
+            raise argparse.ArgumentTypeError(f"{name} must be a positive finite number, got {text!r}")
+        return value
+
+    return parse
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = _Parser(prog="python -m validate", description=__doc__.splitlines()[0])
+    sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
+
+    p = sub.add_parser("all", help="run every registered validation case")
+    p.add_argument("--json", metavar="REPORT.json", help="also write the report as JSON")
+    p.add_argument("--slow", action="store_true", help="include cases tagged slow")
+    p.add_argument("--jobs", type=int, default=2, help="cases run in parallel (default 2)")
+
+    sub.add_parser("list", help="list the registered cases")
+
+    p = sub.add_parser("case", help="run one case")
+    p.add_argument("name")
+    p.add_argument("--json", metavar="REPORT.json", help="also write the report as JSON")
+
+    p = sub.add_parser("modes", help="rest pose, static tensions and small-oscillation periods")
+    p.add_argument("rig")
+    p.add_argument("--json", action="store_true", help="print one JSON object")
+
+    p = sub.add_parser("simulate", help="simulate a rig and write the trajectory CSV")
+    p.add_argument("rig")
+    p.add_argument("--engine", default="kane")
+    p.add_argument("--duration", type=_positive_float("--duration"), required=True)
+    p.add_argument("--dt-out", type=_positive_float("--dt-out"), default=0.01)
+    p.add_argument("--rtol", type=_positive_float("--rtol"), default=1e-10)
+    p.add_argument("--out", required=True, metavar="FILE.csv")
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    try:
+        args = build_parser().parse_args(argv)
+        return _COMMANDS[args.command](args)
+    except (RigError, UsageError) as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
+
+
+def _cmd_modes(args) -> int:
+    from bifilar.kane import KaneModel
+    from bifilar.modes import linearize
+
+    rig = load_rig(args.rig)
+    lin = linearize(KaneModel.from_rig(rig))
+    rest = lin.rest
+    report = {
+        "rig": rig.name,
+        "engine": "kane",
+        "equilibrium": {
+            "com": rest.com.tolist(),
+            "rotation": rest.rotation.tolist(),
+            "tensions": rest.tensions.tolist(),
+        },
+        "modes": [
+            {"period": m.period, "omega2": m.omega2, "com_shape": m.com.tolist(), "rotation_shape": m.rotation.tolist()}
+            for m in lin.modes
+        ],
+    }
+    if args.json:
+        print(json.dumps(report))
+        return 0
+    print(f"rig {rig.name}: rest COM {_fmt(rest.com)} m, tensions {_fmt(rest.tensions)} N")
+    for i, m in enumerate(lin.modes, start=1):
+        period = "neutral/unstable" if m.period is None else f"{m.period:.9g} s"
+        print(f"  mode {i}: period {period}; COM shape {_fmt(m.com)} m, rotation shape {_fmt(m.rotation)} rad")
+    return 0
+
+
+def _cmd_simulate(args) -> int:
+    from .engines import engines
+    from .trajectory import write_rig_csv
+
+    available = engines()
+    if args.engine not in available:
+        raise UsageError(f"--engine: unknown engine {args.engine!r} (choose from {', '.join(available)})")
+    rig = load_rig(args.rig)
+    traj = available[args.engine](rig, args.duration, args.dt_out, args.rtol)
+    write_rig_csv(traj, args.out)
+    slack = traj.meta.get("slack")
+    if slack:
+        wire, t = slack
+        print(
+            f"error: {args.rig}: wire[{wire}]: went slack at t = {t:.6g} s; the {args.engine} model assumes taut "
+            f"wires, so {args.out} ends there",
+            file=sys.stderr,
+        )
+        return 3
+    return 0
+
+
+def _cmd_list(args) -> int:
+    from .suite import registered
+
+    for c in registered(slow=True):
+        tags = ",".join(sorted(c.tags))
+        print(f"{c.name:40s} [{tags}] {c.source}: {c.description.splitlines()[0] if c.description else ''}")
+    return 0
+
+
+def _cmd_all(args) -> int:
+    from .suite import registered, run_cases
+
+    return run_cases(registered(slow=args.slow), jobs=args.jobs, json_path=args.json)
+
+
+def _cmd_case(args) -> int:
+    from .suite import find, run_cases
+
+    return run_cases([find(args.name)], jobs=1, json_path=args.json)
+
+
+def _fmt(values) -> str:
+    return "[" + ", ".join(f"{v:.9g}" for v in values) + "]"
+
+
+_COMMANDS = {
+    "all": _cmd_all,
+    "list": _cmd_list,
+    "case": _cmd_case,
+    "modes": _cmd_modes,
+    "simulate": _cmd_simulate,
+}

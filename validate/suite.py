@@ -1,0 +1,113 @@
+"""Running registered cases: in parallel worker processes, into a table and a JSON report.
+
+A case that raises is reported as failed with the exception as its one metric, so one broken case
+never hides the others' results.
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+import time
+import traceback
+from concurrent.futures import ProcessPoolExecutor
+from dataclasses import asdict, dataclass, field
+
+from .registry import REGISTRY, Case, CaseContext, Metric
+
+
+@dataclass
+class CaseResult:
+    name: str
+    source: str
+    passed: bool
+    seconds: float
+    metrics: list[Metric]
+    error: str | None = None
+    trajectories: list = field(default_factory=list)
+
+
+def registered(slow: bool = False) -> list[Case]:
+    """Every registered case, fast ones only unless ``slow``."""
+    from .cases import load_all
+
+    load_all()
+    return [c for c in REGISTRY.values() if slow or "slow" not in c.tags]
+
+
+def find(name: str) -> Case:
+    from .cli import UsageError
+
+    cases = {c.name: c for c in registered(slow=True)}
+    if name not in cases:
+        raise UsageError(f"case: unknown case {name!r} (see python -m validate list)")
+    return cases[name]
+
+
+def run_case(name: str, keep_trajectories: bool = False) -> CaseResult:
+    """Run one case by name (in this process)."""
+    c = find(name)
+    ctx = CaseContext()
+    start = time.perf_counter()
+    try:
+        metrics = list(c.run(ctx))
+        error = None
+    except Exception as exc:  # reported, not raised: see the module docstring
+        metrics, error = [], f"{type(exc).__name__}: {exc}\n{traceback.format_exc()}"
+    seconds = time.perf_counter() - start
+    passed = error is None and bool(metrics) and all(m.passed for m in metrics)
+    return CaseResult(c.name, c.source, passed, seconds, metrics, error, ctx.trajectories if keep_trajectories else [])
+
+
+def run_cases(cases: list[Case], jobs: int = 2, json_path: str | None = None, keep_trajectories: bool = False) -> int:
+    """Run the cases, print the table (and write the JSON report); 0 if all passed, else 1."""
+    names = [c.name for c in cases]
+    if jobs > 1 and len(names) > 1:
+        with ProcessPoolExecutor(max_workers=jobs) as pool:
+            results = list(pool.map(run_case, names, [keep_trajectories] * len(names)))
+    else:
+        results = [run_case(n, keep_trajectories) for n in names]
+    print(format_table(results))
+    passed = all(r.passed for r in results)
+    if json_path:
+        from .trajectory import atomic_write_text
+
+        atomic_write_text(json_path, json.dumps(report(results), indent=1) + "\n")
+    return 0 if passed else 1
+
+
+def report(results: list[CaseResult]) -> dict:
+    """The JSON report: ``{"passed", "cases": [{"name", "source", "passed", "metrics": [...]}]}``."""
+    return {
+        "passed": all(r.passed for r in results),
+        "cases": [
+            {
+                "name": r.name,
+                "source": r.source,
+                "passed": r.passed,
+                "seconds": round(r.seconds, 3),
+                "error": r.error.splitlines()[0] if r.error else None,
+                "metrics": [asdict(m) for m in r.metrics],
+            }
+            for r in results
+        ],
+    }
+
+
+def format_table(results: list[CaseResult]) -> str:
+    """One row per metric: case, metric, measured value, tolerance, verdict; then a summary."""
+    rows = [("case", "metric", "value", "tolerance", "", "reason")]
+    for r in results:
+        if r.error:
+            rows.append((r.name, "error", r.error.splitlines()[0][:60], "", "FAIL", ""))
+            print(r.error, file=sys.stderr)
+        for m in r.metrics:
+            cmp = ">=" if m.at_least else "<="
+            unit = f" {m.unit}" if m.unit else ""
+            rows.append((r.name, m.name, f"{m.value:.3e}{unit}", f"{cmp} {m.tolerance:.1e}", "pass" if m.passed else "FAIL", m.reason))
+    widths = [max(len(row[i]) for row in rows) for i in range(5)]
+    lines = ["  ".join(cell.ljust(w) for cell, w in zip(row[:5], widths)) + "  " + row[5] for row in rows]
+    n_fail = sum(not r.passed for r in results)
+    n_metrics = sum(len(r.metrics) for r in results)
+    lines.append(f"{len(results) - n_fail} passed, {n_fail} failed ({len(results)} cases, {n_metrics} metrics)")
+    return "\n".join(lines)
