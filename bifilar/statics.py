@@ -85,7 +85,9 @@ def rest_pose(rig: Rig) -> Rest:
     Raises :class:`RigError` if no pose holds both wires taut (a wire would have to push).
     """
     scale = float(max(lengths(rig).max(), np.ptp(anchors(rig), axis=0).max(), 1e-3))
-    rotation0 = np.eye(3)
+    # Start slightly turned: a symmetric start can be a stationary point that is not a minimum
+    # (a body balanced upside down); the minimiser must see a gradient to roll off it.
+    rotation0 = Rotation.from_rotvec([0.03, 0.02, 0.01]).as_matrix()
     guess = anchors(rig).mean(axis=0) - np.array([0.0, 0.0, lengths(rig).mean()])
     guess = guess - (np.array([w.attach for w in rig.wires]).mean(axis=0) - rig.com)
     com0 = guess + taut_shift(rig, guess, rotation0)

@@ -1,0 +1,123 @@
+"""Every class of bad rig file gets one line naming file, field and problem, and exit status 2."""
+
+import json
+
+import numpy as np
+import pytest
+
+from validate.assets import RIGS
+from validate.cli import main
+
+GOOD = (RIGS / "plate.toml").read_text()
+
+
+def run_cli(capsys, *args):
+    code = main(list(args))
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+@pytest.mark.parametrize(
+    "edit, field, words",
+    [
+        (lambda s: s.replace("mass = 100.0", ""), "body.mass", "missing"),
+        (lambda s: s.replace("mass = 100.0", "mass = 100.0\ncolour = 3"), "body.colour", "unknown key"),
+        (lambda s: s.replace("gravity = 9.81", "gravity = 9.81\nfoo = 1"), "foo", "unknown key"),
+        (lambda s: s.replace("com = [0.0, 0.0, 0.0]", "com = [0.0, 0.0]"), "body.com", "three numbers"),
+        (lambda s: s.replace("mass = 100.0", "mass = nan"), "body.mass", "finite"),
+        (lambda s: s.replace("mass = 100.0", "mass = -1.0"), "body.mass", "positive"),
+        (lambda s: s.replace("length = 5.0", "length = 0.0", 1), "wire[1].length", "positive"),
+        (lambda s: s.replace("length = 5.0", "length = inf", 1), "wire[1].length", "finite"),
+        (lambda s: s.replace("mass = 100.0", 'mass = "heavy"'), "body.mass", "number"),
+        (lambda s: s.replace("inertia = [216.66666666666666, 60.416666666666664, 260.4166666666667]",
+                             "inertia = [1.0, -2.0, 1.5]"), "body.inertia", "not positive definite"),
+        (lambda s: s.replace("inertia = [216.66666666666666, 60.416666666666664, 260.4166666666667]",
+                             "inertia = [1.0, 1.0, 5.0]"), "body.inertia", "triangle inequality"),
+        (lambda s: s.replace("inertia = [216.66666666666666, 60.416666666666664, 260.4166666666667]",
+                             "inertia = [[2.0, 0.1, 0.0], [0.2, 2.0, 0.0], [0.0, 0.0, 2.0]]"),
+         "body.inertia", "not symmetric"),
+        (lambda s: s[: s.index("[[wire]]", s.index("[[wire]]") + 1)], "wire", "two [[wire]] tables needed"),
+        (lambda s: s.replace("anchor = [0.0, 5.0,", "anchor = [0.0, 50.0,"), "wire", "no taut pose"),
+        (lambda s: s.replace("attach = [0.0, 2.5, 0.5]", "attach = [0.0, -2.5, 0.5]"), "wire[2].attach", "coincides"),
+        (lambda s: s.replace("com = [0.0, 0.0, 0.0]", "com = [0.0, 9.0, 0.0]").replace("-5.0,", "-1.0,")
+         .replace("[0.0, 5.0,", "[0.0, 1.0,"), "wire[1]", "slack at rest"),
+        (lambda s: s.replace("[initial]", "[initial]\nspin = 1"), "initial.spin", "unknown key"),
+        (lambda s: s.replace("mass = 100.0", "mass = = 100.0"), "toml", "not valid TOML"),
+    ],
+)
+def test_bad_rig_is_one_line_with_file_and_field(tmp_path, capsys, edit, field, words):
+    path = tmp_path / "bad.toml"
+    path.write_text(edit(GOOD))
+    code, out, err = run_cli(capsys, "modes", str(path), "--json")
+    assert code == 2
+    assert out == ""
+    lines = err.strip().splitlines()
+    assert len(lines) == 1, err
+    assert lines[0].startswith(f"error: {path}: {field}: "), lines[0]
+    assert words in lines[0]
+
+
+def test_three_wires_are_rejected_by_the_kane_engine(tmp_path, capsys):
+    path = tmp_path / "three.toml"
+    extra = "\n[[wire]]\nanchor = [1.0, 0.0, 4.83]\nattach = [1.0, 0.0, 0.5]\nlength = 4.33\n"
+    path.write_text(GOOD.replace("[initial]", extra + "\n[initial]"))
+    code, _, err = run_cli(capsys, "modes", str(path))
+    assert code == 2
+    assert "wire" in err and err.count("\n") == 1
+
+
+def test_missing_file(capsys):
+    code, _, err = run_cli(capsys, "modes", "/no/such/rig.toml")
+    assert code == 2 and err.startswith("error: /no/such/rig.toml: file: cannot read")
+
+
+def test_modes_json_contract(capsys):
+    code, out, _ = run_cli(capsys, "modes", str(RIGS / "plate.toml"), "--json")
+    assert code == 0
+    data = json.loads(out)
+    assert data["rig"] == "plate" and data["engine"] == "kane"
+    eq = data["equilibrium"]
+    np.testing.assert_allclose(eq["com"], [0, 0, 0], atol=1e-12)
+    np.testing.assert_allclose(eq["rotation"], np.eye(3), atol=1e-12)
+    # 7.2: m g / (2 cos 30 deg) per wire, solved to machine precision.
+    np.testing.assert_allclose(eq["tensions"], [566.3806140750229] * 2, rtol=1e-12)
+    periods = [m["period"] for m in data["modes"]]
+    assert len(periods) == 4 and periods == sorted(periods, reverse=True)
+
+
+def test_neutral_mode_is_null_and_first(capsys):
+    """The thin plate's COM is on CD: tilting about CD (theta1) costs no energy."""
+    code, out, _ = run_cli(capsys, "modes", str(RIGS / "sidesway.toml"), "--json")
+    periods = [m["period"] for m in json.loads(out)["modes"]]
+    assert periods[0] is None and all(p > 0 for p in periods[1:])
+    # Side-sway: planar pendulum of length 5 cos(pi/6) (thesis 6.1), exactly in the linear limit.
+    assert periods[1] == pytest.approx(2 * np.pi * np.sqrt(5 * np.cos(np.pi / 6) / 9.81), rel=1e-10)
+
+
+def test_simulate_writes_the_csv_contract(tmp_path, capsys):
+    out = tmp_path / "plate.csv"
+    code, _, err = run_cli(capsys, "simulate", str(RIGS / "plate.toml"), "--engine", "kane",
+                           "--duration", "2", "--dt-out", "0.1", "--out", str(out))
+    assert code == 0, err
+    lines = out.read_text().splitlines()
+    assert lines[0] == "t,com_x,com_y,com_z,qw,qx,qy,qz,tension_1,tension_2,length_error_1,length_error_2"
+    table = np.array([[float(x) for x in line.split(",")] for line in lines[1:]])
+    assert table.shape == (21, 12)
+    np.testing.assert_allclose(table[:, 0], np.arange(21) * 0.1, atol=1e-12)
+    np.testing.assert_allclose(np.linalg.norm(table[:, 4:8], axis=1), 1.0, atol=1e-12)
+    # Initial state: 0.1745 rad about z, then the pure lift that keeps both wires taut.
+    assert table[0, 4] == pytest.approx(np.cos(0.1745 / 2), abs=1e-12)
+    assert table[0, 7] == pytest.approx(np.sin(0.1745 / 2), abs=1e-12)
+    np.testing.assert_allclose(table[0, 1:3], 0.0, atol=1e-12)
+    assert table[0, 3] > 0.0
+    assert np.abs(table[:, 10:12]).max() < 1e-9
+
+
+def test_simulate_rejects_unknown_engine_and_bad_duration(tmp_path, capsys):
+    code, _, err = run_cli(capsys, "simulate", str(RIGS / "plate.toml"), "--engine", "bogus",
+                           "--duration", "1", "--out", str(tmp_path / "x.csv"))
+    assert code == 2 and "unknown engine" in err and err.count("\n") == 1
+    code, _, err = run_cli(capsys, "simulate", str(RIGS / "plate.toml"), "--duration", "nan",
+                           "--out", str(tmp_path / "x.csv"))
+    assert code == 2 and "--duration" in err
+    assert not (tmp_path / "x.csv").exists()

@@ -1,0 +1,59 @@
+"""Rest pose, static tensions and the rig file's [initial] semantics (engine-neutral statics)."""
+
+import numpy as np
+import pytest
+from scipy.spatial.transform import Rotation
+
+from bifilar.statics import attachments, initial_state, length_errors, rest_pose
+from validate.assets import rig
+
+
+def test_rest_pose_balances_forces_and_moments(any_rig):
+    rest = rest_pose(any_rig)
+    pts = attachments(any_rig, rest.com, rest.rotation)
+    pull = np.array([w.anchor for w in any_rig.wires]) - pts
+    pull = pull / np.linalg.norm(pull, axis=1)[:, None] * rest.tensions[:, None]
+    weight = any_rig.mass * any_rig.gravity
+    np.testing.assert_allclose(pull.sum(axis=0), [0, 0, weight], atol=1e-10 * weight)
+    np.testing.assert_allclose(np.cross(pts - rest.com, pull).sum(axis=0), 0, atol=1e-10 * weight)
+    assert np.abs(length_errors(any_rig, rest.com, rest.rotation)).max() < 1e-12
+    assert np.all(rest.tensions > 0)
+
+
+def test_inverted_start_rolls_to_the_stable_pose():
+    """A COM 5 m above the attachments must hang below them, not balance on top."""
+    r = rig("plate")
+    from dataclasses import replace
+
+    top = replace(r, com=np.array([0.0, 0.0, 5.0]))
+    rest = rest_pose(top)
+    attach_z = attachments(top, rest.com, rest.rotation)[:, 2]
+    assert np.all(rest.com[2] < attach_z)
+
+
+def test_symmetric_twist_is_a_pure_lift():
+    """Issue 2: for a symmetric rig twisted about the vertical, the displacement is a pure lift."""
+    r = rig("plate")
+    s = initial_state(r)
+    np.testing.assert_allclose(s.com[:2], 0.0, atol=1e-12)
+    # Each attachment turns on a circle of radius 2.5 m: the wire's horizontal reach becomes
+    # sqrt(2.5^2 + 5^2 - 2*2.5*5 cos(0.1745)) and the lift follows from Pythagoras.
+    reach = np.sqrt(2.5**2 + 5**2 - 2 * 2.5 * 5 * np.cos(0.1745))
+    lift = np.sqrt(25 - 2.5**2) - np.sqrt(25 - reach**2)
+    assert s.com[2] == pytest.approx(lift, abs=1e-12)
+    np.testing.assert_allclose(s.rotation, Rotation.from_rotvec([0, 0, 0.1745]).as_matrix(), atol=1e-15)
+    np.testing.assert_allclose(s.velocity, 0.0, atol=1e-15)
+
+
+def test_initial_velocity_is_the_least_norm_one_that_keeps_lengths():
+    r = rig("asymmetric")
+    s = initial_state(r)
+    pts = attachments(r, s.com, s.rotation)
+    dirs = pts - np.array([w.anchor for w in r.wires])
+    rates = np.einsum("ij,ij->i", dirs, s.velocity + np.cross(s.omega, pts - s.com))
+    np.testing.assert_allclose(rates, 0.0, atol=1e-13)
+    # Least norm: the velocity lies in the span of the wire directions.
+    residual = s.velocity - dirs.T @ np.linalg.lstsq(dirs.T, s.velocity, rcond=None)[0]
+    np.testing.assert_allclose(residual, 0.0, atol=1e-13)
+    np.testing.assert_allclose(s.omega, r.initial_omega)
+    assert np.abs(length_errors(r, s.com, s.rotation)).max() < 1e-12
