@@ -115,9 +115,9 @@ def _cmd_simulate(args) -> int:
     rig = load_rig(args.rig)
     traj = available[args.engine](rig, args.duration, args.dt_out, args.rtol)
     write_rig_csv(traj, args.out)
-    slack = traj.meta.get("slack")
-    if slack:
-        wire, t = slack
+    failure = traj.meta.get("taut_failure")
+    if failure:
+        wire, t = failure
         print(
             f"error: {args.rig}: wire[{wire}]: went slack at t = {t:.6g} s; the {args.engine} model assumes taut "
             f"wires, so {args.out} ends there",

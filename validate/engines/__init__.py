@@ -2,7 +2,9 @@
 
 Every engine starts from :func:`bifilar.statics.initial_state` (the rig file's ``[initial]``
 semantics) and returns the rig channels of :data:`validate.trajectory.RIG_CHANNELS` plus
-``velocity`` and ``omega`` (world frame) and ``energy`` (J, zero potential at z = 0).
+``velocity`` and ``omega`` (world frame) and ``energy`` (J, zero potential at z = 0). ``meta`` holds
+``rig`` (name) and ``rig_spec`` (the :class:`~bifilar.rig.Rig`, for drawing); an engine whose model
+cannot continue past a slack wire sets ``taut_failure = (wire, time)``.
 An engine is ``run(rig, duration, dt_out, rtol) -> Trajectory``; ``rtol`` is the integrator's
 relative tolerance where the engine has one and is ignored otherwise.
 """

@@ -32,5 +32,6 @@ def to_trajectory(kr: KaneRun, rig: Rig, rtol: float) -> Trajectory:
         "energy": kr.energy,
         "theta": kr.theta,
     }
-    meta = {"rig": rig.name, "rtol": rtol, "nfev": kr.nfev, "slack": kr.slack}
+    # taut_failure: (wire, time) where a wire went slack and the taut-wire model stopped, else None.
+    meta = {"rig": rig.name, "rig_spec": rig, "rtol": rtol, "nfev": kr.nfev, "taut_failure": kr.slack}
     return Trajectory("kane", kr.t, channels, meta)
