@@ -40,6 +40,56 @@ P_SIZE = 23
 
 
 @njit(cache=True)
+def _mv(A, x):
+    """A @ x with loops: numba sends small `@` to BLAS, whose call overhead dominates at 3x5."""
+    out = np.zeros(A.shape[0])
+    for i in range(A.shape[0]):
+        for j in range(A.shape[1]):
+            out[i] += A[i, j] * x[j]
+    return out
+
+
+@njit(cache=True)
+def _mm(A, B):
+    """A @ B with loops (see :func:`_mv`)."""
+    out = np.zeros((A.shape[0], B.shape[1]))
+    for i in range(A.shape[0]):
+        for k in range(A.shape[1]):
+            a = A[i, k]
+            for j in range(B.shape[1]):
+                out[i, j] += a * B[k, j]
+    return out
+
+
+@njit(cache=True)
+def _solve(A, b):
+    """Solve A x = b by Gaussian elimination with partial pivoting (A, b are copied)."""
+    n = b.shape[0]
+    M = A.copy()
+    x = b.copy()
+    for k in range(n):
+        piv = k
+        for i in range(k + 1, n):
+            if abs(M[i, k]) > abs(M[piv, k]):
+                piv = i
+        if piv != k:
+            for j in range(n):
+                M[k, j], M[piv, j] = M[piv, j], M[k, j]
+            x[k], x[piv] = x[piv], x[k]
+        for i in range(k + 1, n):
+            f = M[i, k] / M[k, k]
+            for j in range(k, n):
+                M[i, j] -= f * M[k, j]
+            x[i] -= f * x[k]
+    for i in range(n - 1, -1, -1):
+        acc = x[i]
+        for j in range(i + 1, n):
+            acc -= M[i, j] * x[j]
+        x[i] = acc / M[i, i]
+    return x
+
+
+@njit(cache=True)
 def wire_direction(q2, q3, chart):
     """Unit vector of BC and its partials: u, du/dq2, du/dq3, d2u/dq2^2, d2u/dq2dq3, d2u/dq3^2."""
     s2, c2, s3, c3 = np.sin(q2), np.cos(q2), np.sin(q3), np.cos(q3)
@@ -89,7 +139,7 @@ def kinematics(th, dth, p, chart):
     R = body_frame(th[0], th[3], th[4])
     n3t = R[:, 2]
     rho = np.array([p[P_R] * p[P_SLAM], 0.0, -p[P_R] * p[P_CLAM]])
-    r = R @ rho
+    r = _mv(R, rho)
     s4, c4, s5, c5 = np.sin(th[3]), np.cos(th[3]), np.sin(th[4]), np.cos(th[4])
     # Angular velocity omega = th1' n~3 - th4' n3 + th5' (c4 n1 - s4 n2): the basis Q of (5.1.8).
     G = np.zeros((3, 5))
@@ -97,7 +147,7 @@ def kinematics(th, dth, p, chart):
     G[2, 3] = -1.0
     G[0, 4] = c4
     G[1, 4] = -s4
-    omega = G @ dth
+    omega = _mv(G, dth)
     # Partials of n~3 = -(s4 c5, c4 c5, s5) and of the th5 axis e5 = (c4, -s4, 0).
     n3t_4 = np.array([-c4 * c5, s4 * c5, 0.0])
     n3t_5 = np.array([s4 * s5, c4 * s5, -c5])
@@ -128,7 +178,7 @@ def kinematics(th, dth, p, chart):
 def inertia_world(R, p):
     """Inertia about R* in world axes (kg m^2)."""
     Ib = p[11:20].copy().reshape((3, 3))
-    return R @ Ib @ R.T
+    return _mm(_mm(R, Ib), R.T.copy())
 
 
 @njit(cache=True)
@@ -137,20 +187,22 @@ def eom(th, dth, p, chart):
     differentiated twice (beta^T theta'' = -d2g/dt2 at zero theta'')."""
     u, R, r, V, G, vbias, wbias, d, J, dbias = kinematics(th, dth, p, chart)
     m, g = p[P_M], p[P_G]
-    beta = 2.0 * (J.T @ d)  # (5.1.3)
+    beta = 2.0 * _mv(J.T.copy(), d)  # (5.1.3)
     gamma = -beta[:4] / beta[4]  # (5.1.4)
     # Partial velocities with theta5' eliminated: V_new (5.1.21), G_new (5.1.19).
     Vn = V[:, :4] + np.outer(V[:, 4], gamma)
     Gn = G[:, :4] + np.outer(G[:, 4], gamma)
     Iw = inertia_world(R, p)
-    omega = G @ dth
+    omega = _mv(G, dth)
     M5 = np.empty((5, 5))
     N5 = np.empty(5)
-    M5[:4, :] = m * (Vn.T @ V) + Gn.T @ (Iw @ G)
+    VnT, GnT = Vn.T.copy(), Gn.T.copy()
+    M5[:4, :] = m * _mm(VnT, V) + _mm(GnT, _mm(Iw, G))
     weight = np.array([0.0, 0.0, m * g])
-    N5[:4] = -(Vn.T @ (m * vbias + weight)) - Gn.T @ (Iw @ wbias + np.cross(omega, Iw @ omega))
+    Iw_omega = _mv(Iw, omega)
+    N5[:4] = -_mv(VnT, m * vbias + weight) - _mv(GnT, _mv(Iw, wbias) + np.cross(omega, Iw_omega))
     M5[4, :] = beta
-    ddot = J @ dth
+    ddot = _mv(J, dth)
     N5[4] = -2.0 * (ddot @ ddot + d @ dbias)
     return M5, N5
 
@@ -159,7 +211,7 @@ def eom(th, dth, p, chart):
 def accelerations(th, dth, p, chart):
     """theta'' from M5 theta'' = N5."""
     M5, N5 = eom(th, dth, p, chart)
-    return np.linalg.solve(M5, N5)
+    return _solve(M5, N5)
 
 
 @njit(cache=True)
@@ -178,7 +230,7 @@ def pose(th, p, chart):
     R = body_frame(th[0], th[3], th[4])
     rho = np.array([p[P_R] * p[P_SLAM], 0.0, -p[P_R] * p[P_CLAM]])
     c = p[20:23] + p[P_L] * u
-    return c + R @ rho, R
+    return c + _mv(R, rho), R
 
 
 @njit(cache=True)
@@ -193,9 +245,9 @@ def loads(th, dth, p, chart):
     u, R, r, V, G, vbias, wbias, d, J, dbias = kinematics(th, dth, p, chart)
     dd = accelerations(th, dth, p, chart)
     m, g, bp = p[P_M], p[P_G], p[P_BP]
-    acc = V @ dd + vbias
-    alpha = G @ dd + wbias
-    omega = G @ dth
+    acc = _mv(V, dd) + vbias
+    alpha = _mv(G, dd) + wbias
+    omega = _mv(G, dth)
     Iw = inertia_world(R, p)
     e1 = -u  # from C towards B
     e2 = -d / np.sqrt(d @ d)  # from D towards A
@@ -208,9 +260,10 @@ def loads(th, dth, p, chart):
     A[3:, 1] = np.cross(arm_d, e2) / bp
     rhs_ = np.empty(6)
     rhs_[:3] = m * acc + np.array([0.0, 0.0, m * g])
-    rhs_[3:] = (Iw @ alpha + np.cross(omega, Iw @ omega)) / bp
-    tension = np.linalg.solve(A.T @ A, A.T @ rhs_)
-    res = A @ tension - rhs_
+    rhs_[3:] = (_mv(Iw, alpha) + np.cross(omega, _mv(Iw, omega))) / bp
+    At = A.T.copy()
+    tension = _solve(_mm(At, A), _mv(At, rhs_))
+    res = _mv(A, tension) - rhs_
     return tension, acc, alpha, np.sqrt(res @ res)
 
 
@@ -234,10 +287,10 @@ def observe(Y, p, chart):
         c, _ = pose(th, p, chart)
         com[i] = c
         frames[i] = R
-        vel[i] = V @ dth
-        omg[i] = G @ dth
+        vel[i] = _mv(V, dth)
+        omg[i] = _mv(G, dth)
         tension[i] = loads(th, dth, p, chart)[0]
         err2[i] = np.sqrt(d @ d) - p[P_LP]
         Iw = inertia_world(R, p)
-        energy[i] = 0.5 * m * (vel[i] @ vel[i]) + 0.5 * (omg[i] @ (Iw @ omg[i])) + m * g * c[2]
+        energy[i] = 0.5 * m * (vel[i] @ vel[i]) + 0.5 * (omg[i] @ _mv(Iw, omg[i])) + m * g * c[2]
     return com, frames, vel, omg, tension, err2, energy

@@ -11,20 +11,24 @@ that the command line can print it as one line and exit with status 2.
 
 from __future__ import annotations
 
-import math
-import tomllib
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
 
+from .checks import (
+    RigError,
+    inertia_tensor,
+    no_unknown,
+    non_negative,
+    positive,
+    read_toml,
+    required,
+    table,
+    vector3,
+)
 
-class RigError(ValueError):
-    """A rig that cannot be used: ``source: field: problem``."""
-
-    def __init__(self, source: str, field_name: str, problem: str):
-        self.source, self.field, self.problem = source, field_name, problem
-        super().__init__(f"{source}: {field_name}: {problem}")
+__all__ = ["Rig", "RigError", "Uncertainty", "Wire", "load_rig", "rig_from_dict", "check_reachable"]
 
 
 @dataclass(frozen=True)
@@ -81,32 +85,23 @@ _UNCERTAINTY_KEYS = set(Uncertainty.__dataclass_fields__)
 
 def load_rig(path: str | Path) -> Rig:
     """Read and check a rig file; raise :class:`RigError` on any problem."""
-    path = Path(path)
-    src = str(path)
-    try:
-        text = path.read_text()
-    except OSError as exc:
-        raise RigError(src, "file", f"cannot read ({exc.strerror})") from None
-    try:
-        data = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise RigError(src, "toml", f"not valid TOML ({exc})") from None
-    return rig_from_dict(data, source=src, default_name=path.stem)
+    data = read_toml(path)
+    return rig_from_dict(data, source=str(path), default_name=Path(path).stem)
 
 
 def rig_from_dict(data: dict, source: str = "<memory>", default_name: str = "rig") -> Rig:
     """Build a checked :class:`Rig` from the parsed TOML table (see the module docstring)."""
-    _no_unknown(data, _TOP_KEYS, source, "")
+    no_unknown(data, _TOP_KEYS, source, "")
     name = data.get("name", default_name)
     if not isinstance(name, str) or not name:
         raise RigError(source, "name", "must be a non-empty string")
-    gravity = _positive(data.get("gravity", 9.81), source, "gravity")
+    gravity = positive(data.get("gravity", 9.81), source, "gravity")
 
-    body = _table(data, "body", source, required=True)
-    _no_unknown(body, _BODY_KEYS, source, "body.")
-    mass = _positive(_required(body, "mass", source, "body."), source, "body.mass")
-    com = _vector(body.get("com", [0.0, 0.0, 0.0]), source, "body.com")
-    inertia = _inertia(_required(body, "inertia", source, "body."), source)
+    body = table(data, "body", source, mandatory=True)
+    no_unknown(body, _BODY_KEYS, source, "body.")
+    mass = positive(required(body, "mass", source, "body."), source, "body.mass")
+    com = vector3(body.get("com", [0.0, 0.0, 0.0]), source, "body.com")
+    inertia = inertia_tensor(required(body, "inertia", source, "body."), source)
 
     wires_raw = data.get("wire")
     if not isinstance(wires_raw, list) or not all(isinstance(w, dict) for w in wires_raw):
@@ -116,24 +111,24 @@ def rig_from_dict(data: dict, source: str = "<memory>", default_name: str = "rig
     wires = []
     for i, w in enumerate(wires_raw, start=1):
         prefix = f"wire[{i}]."
-        _no_unknown(w, _WIRE_KEYS, source, prefix)
+        no_unknown(w, _WIRE_KEYS, source, prefix)
         wires.append(
             Wire(
-                anchor=_vector(_required(w, "anchor", source, prefix), source, prefix + "anchor"),
-                attach=_vector(_required(w, "attach", source, prefix), source, prefix + "attach"),
-                length=_positive(_required(w, "length", source, prefix), source, prefix + "length"),
+                anchor=vector3(required(w, "anchor", source, prefix), source, prefix + "anchor"),
+                attach=vector3(required(w, "attach", source, prefix), source, prefix + "attach"),
+                length=positive(required(w, "length", source, prefix), source, prefix + "length"),
             )
         )
 
-    initial = _table(data, "initial", source, required=False)
-    _no_unknown(initial, _INITIAL_KEYS, source, "initial.")
-    rotation = _vector(initial.get("rotation", [0.0, 0.0, 0.0]), source, "initial.rotation")
-    omega = _vector(initial.get("omega", [0.0, 0.0, 0.0]), source, "initial.omega")
+    initial = table(data, "initial", source, mandatory=False)
+    no_unknown(initial, _INITIAL_KEYS, source, "initial.")
+    rotation = vector3(initial.get("rotation", [0.0, 0.0, 0.0]), source, "initial.rotation")
+    omega = vector3(initial.get("omega", [0.0, 0.0, 0.0]), source, "initial.omega")
 
-    unc_raw = _table(data, "uncertainty", source, required=False)
-    _no_unknown(unc_raw, _UNCERTAINTY_KEYS, source, "uncertainty.")
+    unc_raw = table(data, "uncertainty", source, mandatory=False)
+    no_unknown(unc_raw, _UNCERTAINTY_KEYS, source, "uncertainty.")
     unc = Uncertainty(
-        **{k: _non_negative(v, source, f"uncertainty.{k}") for k, v in unc_raw.items()}
+        **{k: non_negative(v, source, f"uncertainty.{k}") for k, v in unc_raw.items()}
     )
 
     rig = Rig(
@@ -177,78 +172,3 @@ def check_reachable(rig: Rig) -> None:
             )
 
 
-def _required(table: dict, key: str, source: str, prefix: str):
-    if key not in table:
-        raise RigError(source, prefix + key, "missing")
-    return table[key]
-
-
-def _table(data: dict, key: str, source: str, required: bool) -> dict:
-    value = data.get(key)
-    if value is None:
-        if required:
-            raise RigError(source, key, "missing: give a [" + key + "] table")
-        return {}
-    if not isinstance(value, dict):
-        raise RigError(source, key, "must be a table")
-    return value
-
-
-def _no_unknown(table: dict, allowed: set, source: str, prefix: str) -> None:
-    unknown = sorted(set(table) - allowed)
-    if unknown:
-        raise RigError(source, prefix + unknown[0], f"unknown key (allowed: {', '.join(sorted(allowed))})")
-
-
-def _number(value, source: str, name: str) -> float:
-    if isinstance(value, bool) or not isinstance(value, (int, float)):
-        raise RigError(source, name, f"must be a number, got {type(value).__name__}")
-    if not math.isfinite(value):
-        raise RigError(source, name, f"must be finite, got {value}")
-    return float(value)
-
-
-def _positive(value, source: str, name: str) -> float:
-    x = _number(value, source, name)
-    if x <= 0.0:
-        raise RigError(source, name, f"must be positive, got {x:g}")
-    return x
-
-
-def _non_negative(value, source: str, name: str) -> float:
-    x = _number(value, source, name)
-    if x < 0.0:
-        raise RigError(source, name, f"must be non-negative, got {x:g}")
-    return x
-
-
-def _vector(value, source: str, name: str) -> np.ndarray:
-    if not isinstance(value, list) or len(value) != 3:
-        raise RigError(source, name, "must be a list of three numbers")
-    return np.array([_number(v, source, f"{name}[{i}]") for i, v in enumerate(value)])
-
-
-def _inertia(value, source: str) -> np.ndarray:
-    name = "body.inertia"
-    if isinstance(value, list) and len(value) == 3 and all(isinstance(r, list) for r in value):
-        rows = [_vector(r, source, f"{name}[{i}]") for i, r in enumerate(value)]
-        tensor = np.array(rows)
-        if not np.allclose(tensor, tensor.T, rtol=1e-12, atol=1e-12 * np.abs(tensor).max()):
-            raise RigError(source, name, "is not symmetric")
-    elif isinstance(value, list) and len(value) == 3:
-        tensor = np.diag(_vector(value, source, name))
-    else:
-        raise RigError(source, name, "must be three principal moments or a symmetric 3x3 matrix")
-    moments = np.linalg.eigvalsh(tensor)
-    if moments[0] <= 0.0:
-        raise RigError(source, name, f"is not positive definite (eigenvalues {_fmt(moments)})")
-    # A real body has I_a + I_b >= I_c for its principal moments; allow rounding in the last digit.
-    if moments[0] + moments[1] < moments[2] * (1.0 - 1e-9):
-        raise RigError(
-            source, name, f"breaks the triangle inequality I1 + I2 >= I3 (principal moments {_fmt(moments)})"
-        )
-    return 0.5 * (tensor + tensor.T)
-
-
-def _fmt(values) -> str:
-    return "[" + ", ".join(f"{v:.6g}" for v in values) + "]"

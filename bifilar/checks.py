@@ -1,0 +1,111 @@
+"""Reading TOML input files field by field, with one-line errors that name file, field and problem.
+
+Every problem is raised as :class:`RigError` (``source: field: problem``), which the command line
+prints as one line before exiting with status 2.
+"""
+
+from __future__ import annotations
+
+import math
+import tomllib
+from pathlib import Path
+
+import numpy as np
+
+
+class RigError(ValueError):
+    """An input that cannot be used: ``source: field: problem``."""
+
+    def __init__(self, source: str, field_name: str, problem: str):
+        self.source, self.field, self.problem = source, field_name, problem
+        super().__init__(f"{source}: {field_name}: {problem}")
+
+
+def read_toml(path: str | Path) -> dict:
+    """Parse a TOML file; an unreadable or malformed file is a :class:`RigError`."""
+    src = str(path)
+    try:
+        text = Path(path).read_text()
+    except OSError as exc:
+        raise RigError(src, "file", f"cannot read ({exc.strerror})") from None
+    try:
+        return tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise RigError(src, "toml", f"not valid TOML ({exc})") from None
+
+
+def required(table: dict, key: str, source: str, prefix: str):
+    if key not in table:
+        raise RigError(source, prefix + key, "missing")
+    return table[key]
+
+
+def table(data: dict, key: str, source: str, mandatory: bool) -> dict:
+    value = data.get(key)
+    if value is None:
+        if mandatory:
+            raise RigError(source, key, "missing: give a [" + key + "] table")
+        return {}
+    if not isinstance(value, dict):
+        raise RigError(source, key, "must be a table")
+    return value
+
+
+def no_unknown(table: dict, allowed: set, source: str, prefix: str) -> None:
+    unknown = sorted(set(table) - allowed)
+    if unknown:
+        raise RigError(source, prefix + unknown[0], f"unknown key (allowed: {', '.join(sorted(allowed))})")
+
+
+def number(value, source: str, name: str) -> float:
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise RigError(source, name, f"must be a number, got {type(value).__name__}")
+    if not math.isfinite(value):
+        raise RigError(source, name, f"must be finite, got {value}")
+    return float(value)
+
+
+def positive(value, source: str, name: str) -> float:
+    x = number(value, source, name)
+    if x <= 0.0:
+        raise RigError(source, name, f"must be positive, got {x:g}")
+    return x
+
+
+def non_negative(value, source: str, name: str) -> float:
+    x = number(value, source, name)
+    if x < 0.0:
+        raise RigError(source, name, f"must be non-negative, got {x:g}")
+    return x
+
+
+def vector3(value, source: str, name: str) -> np.ndarray:
+    if not isinstance(value, list) or len(value) != 3:
+        raise RigError(source, name, "must be a list of three numbers")
+    return np.array([number(v, source, f"{name}[{i}]") for i, v in enumerate(value)])
+
+
+def inertia_tensor(value, source: str) -> np.ndarray:
+    name = "body.inertia"
+    if isinstance(value, list) and len(value) == 3 and all(isinstance(r, list) for r in value):
+        rows = [vector3(r, source, f"{name}[{i}]") for i, r in enumerate(value)]
+        tensor = np.array(rows)
+        if not np.allclose(tensor, tensor.T, rtol=1e-12, atol=1e-12 * np.abs(tensor).max()):
+            raise RigError(source, name, "is not symmetric")
+    elif isinstance(value, list) and len(value) == 3:
+        tensor = np.diag(vector3(value, source, name))
+    else:
+        raise RigError(source, name, "must be three principal moments or a symmetric 3x3 matrix")
+    moments = np.linalg.eigvalsh(tensor)
+    if moments[0] <= 0.0:
+        raise RigError(source, name, f"is not positive definite (eigenvalues {fmt_values(moments)})")
+    # A real body has I_a + I_b >= I_c for its principal moments; allow rounding in the last digit.
+    if moments[0] + moments[1] < moments[2] * (1.0 - 1e-9):
+        raise RigError(
+            source, name, f"breaks the triangle inequality I1 + I2 >= I3 (principal moments {fmt_values(moments)})"
+        )
+    return 0.5 * (tensor + tensor.T)
+
+
+def fmt_values(values) -> str:
+    return "[" + ", ".join(f"{v:.6g}" for v in values) + "]"
