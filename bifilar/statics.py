@@ -90,7 +90,10 @@ def rest_pose(rig: Rig) -> Rest:
     rotation0 = Rotation.from_rotvec([0.03, 0.02, 0.01]).as_matrix()
     guess = anchors(rig).mean(axis=0) - np.array([0.0, 0.0, lengths(rig).mean()])
     guess = guess - (np.array([w.attach for w in rig.wires]).mean(axis=0) - rig.com)
-    com0 = guess + taut_shift(rig, guess, rotation0)
+    try:
+        com0 = guess + taut_shift(rig, guess, rotation0)
+    except RigError:  # no taut pose at this orientation: let the minimiser find a feasible one
+        com0 = guess
 
     def potential(x):
         return x[2] / scale

@@ -5,8 +5,9 @@ semantics) and returns the rig channels of :data:`validate.trajectory.RIG_CHANNE
 ``velocity`` and ``omega`` (world frame) and ``energy`` (J, zero potential at z = 0). ``meta`` holds
 ``rig`` (name) and ``rig_spec`` (the :class:`~bifilar.rig.Rig`, for drawing); an engine whose model
 cannot continue past a slack wire sets ``taut_failure = (wire, time)``.
-An engine is ``run(rig, duration, dt_out, rtol) -> Trajectory``; ``rtol`` is the integrator's
-relative tolerance where the engine has one and is ignored otherwise.
+An engine is ``run(rig, duration, dt_out, rtol, state=None) -> Trajectory``; ``rtol`` is the
+integrator's relative tolerance where the engine has one and is ignored otherwise; ``state`` (a
+:class:`bifilar.statics.State`) replaces the rig's initial state when a case needs another one.
 """
 
 from __future__ import annotations

@@ -8,15 +8,16 @@ from scipy.spatial.transform import Rotation
 from bifilar.kane import KaneModel
 from bifilar.rig import Rig
 from bifilar.simulate import KaneRun, simulate
-from bifilar.statics import initial_state
+from bifilar.statics import State, initial_state
 
 from ..trajectory import Trajectory
 
 
-def run(rig: Rig, duration: float, dt_out: float = 0.01, rtol: float = 1e-10) -> Trajectory:
-    """Integrate the rig's initial state; see :func:`bifilar.simulate.simulate`."""
+def run(rig: Rig, duration: float, dt_out: float = 0.01, rtol: float = 1e-10, state: State | None = None) -> Trajectory:
+    """Integrate from ``state`` (default: the rig's initial state); see :func:`bifilar.simulate.simulate`."""
     model = KaneModel.from_rig(rig)
-    return to_trajectory(simulate(model, initial_state(rig), duration, dt_out=dt_out, rtol=rtol), rig, rtol)
+    start = initial_state(rig) if state is None else state
+    return to_trajectory(simulate(model, start, duration, dt_out=dt_out, rtol=rtol), rig, rtol)
 
 
 def to_trajectory(kr: KaneRun, rig: Rig, rtol: float) -> Trajectory:
