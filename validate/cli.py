@@ -44,12 +44,14 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--json", metavar="REPORT.json", help="also write the report as JSON")
     p.add_argument("--slow", action="store_true", help="include cases tagged slow")
     p.add_argument("--jobs", type=int, default=2, help="cases run in parallel (default 2)")
+    p.add_argument("--rerun", metavar="DIR", help="also write one rerun recording per case, DIR/<case>.rrd")
 
     sub.add_parser("list", help="list the registered cases")
 
     p = sub.add_parser("case", help="run one case")
     p.add_argument("name")
     p.add_argument("--json", metavar="REPORT.json", help="also write the report as JSON")
+    p.add_argument("--rerun", metavar="FILE.rrd", help="also write a rerun recording of the case (open: rerun FILE.rrd)")
 
     p = sub.add_parser("modes", help="rest pose, static tensions and small-oscillation periods")
     p.add_argument("rig")
@@ -62,6 +64,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--dt-out", type=_positive_float("--dt-out"), default=0.01)
     p.add_argument("--rtol", type=_positive_float("--rtol"), default=1e-10)
     p.add_argument("--out", required=True, metavar="FILE.csv")
+    p.add_argument("--rerun", metavar="FILE.rrd", help="also write a rerun recording of the run (open: rerun FILE.rrd)")
     return parser
 
 
@@ -114,6 +117,10 @@ def _cmd_simulate(args) -> int:
     rig = load_rig(args.rig)
     traj = available[args.engine](rig, args.duration, args.dt_out, args.rtol)
     write_rig_csv(traj, args.out)
+    if args.rerun:
+        from .recording import record_trajectory
+
+        record_trajectory(traj, args.rerun)
     failure = traj.meta.get("taut_failure")
     if failure:
         wire, t = failure
@@ -138,13 +145,26 @@ def _cmd_list(args) -> int:
 def _cmd_all(args) -> int:
     from .suite import registered, run_cases
 
-    return run_cases(registered(slow=args.slow), jobs=args.jobs, json_path=args.json)
+    return run_cases(registered(slow=args.slow), jobs=args.jobs, json_path=args.json,
+                     on_result=_recorder(args.rerun, folder=True))
 
 
 def _cmd_case(args) -> int:
     from .suite import find, run_cases
 
-    return run_cases([find(args.name)], jobs=1, json_path=args.json)
+    return run_cases([find(args.name)], jobs=1, json_path=args.json, on_result=_recorder(args.rerun, folder=False))
+
+
+def _recorder(dest: str | None, folder: bool):
+    """None without ``--rerun``; else a function writing a case result's recording to ``dest`` (a
+    file), or to ``dest/<case>.rrd`` with ``folder``."""
+    if not dest:
+        return None
+    from pathlib import Path
+
+    from .recording import record_case
+
+    return lambda result: record_case(result, Path(dest) / f"{result.name}.rrd" if folder else dest)
 
 
 def _fmt(values) -> str:

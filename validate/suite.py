@@ -12,6 +12,7 @@ import time
 import traceback
 from concurrent.futures import ProcessPoolExecutor
 from dataclasses import asdict, dataclass, field
+from typing import Callable
 
 from .registry import REGISTRY, Case, CaseContext, Metric
 
@@ -59,15 +60,22 @@ def run_case(name: str, keep_trajectories: bool = False) -> CaseResult:
     return CaseResult(c.name, c.source, passed, seconds, metrics, error, ctx.trajectories if keep_trajectories else [])
 
 
-def run_cases(cases: list[Case], jobs: int = 2, json_path: str | None = None, keep_trajectories: bool = False) -> int:
-    """Run the cases, print the table (and write the JSON report); 0 if all passed, else 1."""
+def run_cases(cases: list[Case], jobs: int = 2, json_path: str | None = None, keep_trajectories: bool = False,
+              on_result: Callable[[CaseResult], object] | None = None) -> int:
+    """Run the cases, print the table (and write the JSON report); 0 if all passed, else 1.
+    ``on_result`` is called on every result in this process (e.g. to record it): it implies
+    ``keep_trajectories``."""
     names = [c.name for c in cases]
+    keep = keep_trajectories or on_result is not None
     if jobs > 1 and len(names) > 1:
         with ProcessPoolExecutor(max_workers=jobs) as pool:
-            results = list(pool.map(run_case, names, [keep_trajectories] * len(names)))
+            results = list(pool.map(run_case, names, [keep] * len(names)))
     else:
-        results = [run_case(n, keep_trajectories) for n in names]
+        results = [run_case(n, keep) for n in names]
     print(format_table(results))
+    if on_result is not None:
+        for r in results:
+            on_result(r)
     passed = all(r.passed for r in results)
     if json_path:
         from .trajectory import atomic_write_text
