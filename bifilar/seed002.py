@@ -1,0 +1,110 @@
+"""Seed 002's three-body pendulum: its frames as a TMT chain, and its MuJoCo model.
+
+The seed (/work/shared/seeds/002_83c2d3773759b45a.txt) builds the pendulum from relative frames,
+each a product of translations and one rotation about e1:
+
+* ``E^1   = T(0, 0, l1) Rx(theta) T(l2, l3, 0)``: body 1, the arm, from the inertial frame;
+* ``E^2_1 = T(0, l4, 0) Rx(phi) T(l5, l6, 0)``: body 2, the rod, from the arm;
+* ``E^3_2 = T(0, l7, 0)``: body 3, the ball, fixed to the rod.
+
+Every body frame sits at the body's COM with the body's axes. Inertial e3 is up and gravity acts
+along -e3; ``theta`` is the arm's angle from the horizontal e2 axis, ``phi`` the rod's angle relative
+to the arm. The numbers the seed leaves open are in ``models/seed002/params.toml`` and
+docs/seed002.md says where each comes from.
+"""
+
+from __future__ import annotations
+
+import tomllib
+from dataclasses import dataclass
+from pathlib import Path
+
+import mujoco
+import numpy as np
+
+from .tmt import Body, Chain, Frame
+from .tmt_mujoco import chain_spec
+
+MODEL_DIR = Path(__file__).resolve().parent.parent / "models" / "seed002"
+PARAMS = MODEL_DIR / "params.toml"
+XML = MODEL_DIR / "seed002.xml"
+JOINTS = ("theta", "phi")  # q[0], q[1]: MuJoCo hinge names
+BODIES = ("arm", "rod", "ball")  # bodies 1, 2, 3 of the seed
+E1 = (1.0, 0.0, 0.0)  # both rotations are about e1
+
+
+@dataclass(frozen=True)
+class Params:
+    """The contents of params.toml (SI units, radians)."""
+
+    gravity: float
+    lengths: dict[str, float]  # l1 ... l7
+    bodies: tuple[Body, ...]  # arm, rod, ball
+    q0: np.ndarray  # (theta, phi) at release
+    qd0: np.ndarray
+    visual: dict[str, float]
+    timestep: float  # MuJoCo's, s
+
+
+def load(path: str | Path = PARAMS) -> Params:
+    """Read the parameter file."""
+    data = tomllib.loads(Path(path).read_text())
+    lengths = {f"l{i}": float(data["lengths"][f"l{i}"]) for i in range(1, 8)}
+    bodies = tuple(
+        Body(name, float(data["body"][name]["mass"]), np.array(data["body"][name]["inertia"], dtype=float))
+        for name in BODIES
+    )
+    ini = data["initial"]
+    return Params(
+        gravity=float(data["gravity"]),
+        lengths=lengths,
+        bodies=bodies,
+        q0=np.array([ini["theta"], ini["phi"]], dtype=float),
+        qd0=np.array([ini["theta_dot"], ini["phi_dot"]], dtype=float),
+        visual={k: float(v) for k, v in data["visual"].items()},
+        timestep=float(data["mujoco"]["timestep"]),
+    )
+
+
+def chain(p: Params) -> Chain:
+    """The seed's frames as a TMT chain: q = (theta, phi)."""
+    L = p.lengths
+    arm, rod, ball = p.bodies
+    frames = [
+        Frame(s=(0.0, 0.0, L["l1"]), axis=E1, coordinate=0),  # E'_1 E'_2: up l1, turn by theta
+        Frame(s=(L["l2"], L["l3"], 0.0), body=arm),  # E'_3: out to the arm's COM
+        Frame(s=(0.0, L["l4"], 0.0), axis=E1, coordinate=1),  # to the elbow, turn by phi
+        Frame(s=(L["l5"], L["l6"], 0.0), body=rod),  # out to the rod's COM
+        Frame(s=(0.0, L["l7"], 0.0), body=ball),  # E^3_2: the ball, fixed to the rod
+    ]
+    return Chain(frames, (0.0, 0.0, -p.gravity))
+
+
+def mjspec(p: Params) -> mujoco.MjSpec:
+    """The MuJoCo model of the same chain, with RK4 at the parameter file's timestep, massless
+    visual geoms that never collide, and the release state as keyframe ``release``."""
+    L, vis = p.lengths, p.visual
+    spec = chain_spec(chain(p), JOINTS, model_name="seed002")
+    spec.option.integrator = mujoco.mjtIntegrator.mjINT_RK4
+    spec.option.timestep = p.timestep
+    spec.option.disableflags |= mujoco.mjtDisableBit.mjDSBL_CONTACT
+    arm, rod, ball = (spec.body(name) for name in BODIES)
+    visual = {"contype": 0, "conaffinity": 0}  # bodies carry explicit inertials, so geoms add no mass
+
+    def bar(body, radius, start, end, kind=mujoco.mjtGeom.mjGEOM_CAPSULE):
+        body.add_geom(type=kind, size=[radius, 0, 0], fromto=[*start, *end], **visual)
+
+    # the bearing at the pivot, l1 above the inertial origin, along e1
+    bar(spec.worldbody, 2 * vis["rod_radius"], (-0.03, 0, L["l1"]), (0.03, 0, L["l1"]), mujoco.mjtGeom.mjGEOM_CYLINDER)
+    # arm: the bar from the pivot through its COM, and a bracket from the bar's end to the elbow
+    bar(arm, vis["arm_radius"], (-L["l2"], -L["l3"], 0), (L["l2"], L["l3"], 0))
+    bar(arm, vis["rod_radius"], (L["l2"], L["l3"], 0), (0, L["l4"], 0))
+    bar(rod, vis["rod_radius"], (-L["l5"], -L["l6"], 0), (L["l5"], L["l6"], 0))
+    ball.add_geom(type=mujoco.mjtGeom.mjGEOM_SPHERE, size=[vis["ball_radius"], 0, 0], **visual)
+    spec.add_key(name="release", qpos=p.q0, qvel=p.qd0)
+    return spec
+
+
+def model(p: Params | None = None) -> mujoco.MjModel:
+    """The compiled MuJoCo model of the parameters (default: the shipped file)."""
+    return mjspec(load() if p is None else p).compile()
