@@ -27,6 +27,10 @@ class Metric:
     unit: str = ""
     at_least: bool = False
 
+    def __post_init__(self):  # plain Python types, whatever numpy scalars a case passed in
+        for name, kind in (("value", float), ("tolerance", float), ("passed", bool), ("at_least", bool)):
+            object.__setattr__(self, name, kind(getattr(self, name)))
+
 
 def check(name: str, value: float, tolerance: float, reason: str, *, unit: str = "", at_least: bool = False) -> Metric:
     """``value <= tolerance`` (or ``>=`` with ``at_least``); a value that is not finite fails."""

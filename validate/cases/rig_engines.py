@@ -8,7 +8,7 @@ collected in :data:`AGREEMENT` with the reason for each number.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from scipy.integrate import solve_ivp
@@ -132,8 +132,7 @@ def torsion(ctx: CaseContext):
             measured = period(runs[engine].t, _yaw(runs[engine])).value
             out.append(check(f"{name}: {engine} torsion period vs kane", abs(measured / kane_period - 1.0),
                              AGREEMENT[engine].period, AGREEMENT[engine].reason))
-        out += [Metric(f"{name}: {m.name}", m.value, m.tolerance, m.reason, m.passed, m.unit, m.at_least)
-                for m in agreement_metrics(runs, rest_pose(r).tensions.mean())]
+        out += [replace(m, name=f"{name}: {m.name}") for m in agreement_metrics(runs, rest_pose(r).tensions.mean())]
     return out
 
 
