@@ -6,7 +6,6 @@ Run: python benchmarks/kane.py   (numbers vary with machine load: compare ratios
 
 from __future__ import annotations
 
-import time
 
 import numpy as np
 
@@ -14,16 +13,8 @@ from bifilar import kane_kernel as K
 from bifilar.kane import KaneModel
 from bifilar.simulate import preferred_chart, simulate, state_to_chart
 from bifilar.statics import initial_state
+from timing import best_of
 from validate.assets import rig
-
-
-def best_of(fn, repeat=5):
-    times = []
-    for _ in range(repeat):
-        start = time.perf_counter()
-        fn()
-        times.append(time.perf_counter() - start)
-    return min(times)
 
 
 def main() -> None:

@@ -8,24 +8,15 @@ Run: python benchmarks/recording.py   (numbers vary with machine load: compare w
 from __future__ import annotations
 
 import tempfile
-import time
 from dataclasses import replace
 from pathlib import Path
 
+from timing import best_of
 from validate.assets import rig
 from validate.engines import kane
 from validate.recording import record, record_trajectory
 
 DURATION, DT_OUT = 60.0, 0.01
-
-
-def best_of(fn, repeat=3) -> float:
-    times = []
-    for _ in range(repeat):
-        start = time.perf_counter()
-        fn()
-        times.append(time.perf_counter() - start)
-    return min(times)
 
 
 def main() -> None:

@@ -30,6 +30,10 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from .smallmat import mm as _mm
+from .smallmat import mv as _mv
+from .smallmat import solve as _solve
+
 POLAR, TILT = 0, 1
 
 P_L, P_LP, P_BP, P_R, P_SLAM, P_CLAM, P_M, P_G = range(8)
@@ -37,56 +41,6 @@ P_AB = slice(8, 11)  # B - A, world frame
 P_INERTIA = slice(11, 20)  # inertia about R* in the n~ frame, row-major
 P_B = slice(20, 23)  # anchor B of wire 1, world frame
 P_SIZE = 23
-
-
-@njit(cache=True)
-def _mv(A, x):
-    """A @ x with loops: numba sends small `@` to BLAS, whose call overhead dominates at 3x5."""
-    out = np.zeros(A.shape[0])
-    for i in range(A.shape[0]):
-        for j in range(A.shape[1]):
-            out[i] += A[i, j] * x[j]
-    return out
-
-
-@njit(cache=True)
-def _mm(A, B):
-    """A @ B with loops (see :func:`_mv`)."""
-    out = np.zeros((A.shape[0], B.shape[1]))
-    for i in range(A.shape[0]):
-        for k in range(A.shape[1]):
-            a = A[i, k]
-            for j in range(B.shape[1]):
-                out[i, j] += a * B[k, j]
-    return out
-
-
-@njit(cache=True)
-def _solve(A, b):
-    """Solve A x = b by Gaussian elimination with partial pivoting (A, b are copied)."""
-    n = b.shape[0]
-    M = A.copy()
-    x = b.copy()
-    for k in range(n):
-        piv = k
-        for i in range(k + 1, n):
-            if abs(M[i, k]) > abs(M[piv, k]):
-                piv = i
-        if piv != k:
-            for j in range(n):
-                M[k, j], M[piv, j] = M[piv, j], M[k, j]
-            x[k], x[piv] = x[piv], x[k]
-        for i in range(k + 1, n):
-            f = M[i, k] / M[k, k]
-            for j in range(k, n):
-                M[i, j] -= f * M[k, j]
-            x[i] -= f * x[k]
-    for i in range(n - 1, -1, -1):
-        acc = x[i]
-        for j in range(i + 1, n):
-            acc -= M[i, j] * x[j]
-        x[i] = acc / M[i, i]
-    return x
 
 
 @njit(cache=True)

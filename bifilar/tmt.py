@@ -40,6 +40,9 @@ import numpy as np
 from numba import njit
 from scipy.integrate import solve_ivp
 
+from .smallmat import mm as _mm
+from .smallmat import mv as _mv
+
 
 @dataclass(frozen=True)
 class Body:
@@ -256,28 +259,6 @@ def _inverse(E):
 def _gyro(omega: np.ndarray) -> np.ndarray:
     """D = blockdiag(0, w~^1, 0, w~^2, ...)."""
     return _block_diag([np.zeros((3, 3))] * len(omega), [_skew(w) for w in omega])
-
-
-@njit(cache=True)
-def _mm(A, B):
-    """A B by explicit loops: for 4x4 matrices much faster than a BLAS call from numba."""
-    out = np.zeros((A.shape[0], B.shape[1]))
-    for i in range(A.shape[0]):
-        for k in range(A.shape[1]):
-            a = A[i, k]
-            for j in range(B.shape[1]):
-                out[i, j] += a * B[k, j]
-    return out
-
-
-@njit(cache=True)
-def _mv(A, v):
-    """A v by explicit loops (see :func:`_mm`)."""
-    out = np.zeros(A.shape[0])
-    for i in range(A.shape[0]):
-        for k in range(A.shape[1]):
-            out[i] += A[i, k] * v[k]
-    return out
 
 
 @njit(cache=True)
