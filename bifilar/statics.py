@@ -138,7 +138,28 @@ def rest_pose(rig: Rig) -> Rest:
             f"wire[{i + 1}]",
             f"would be slack at rest (tension {tensions[i]:.6g} N): the body cannot hang taut on every wire",
         )
-    return Rest(com=sol.x[:3].copy(), rotation=rotation, tensions=tensions)
+    return Rest(com=sol.x[:3].copy(), rotation=_nearest_on_neutral_axis(rig, sol.x[:3], rotation), tensions=tensions)
+
+
+def _nearest_on_neutral_axis(rig: Rig, com: np.ndarray, rotation: np.ndarray) -> np.ndarray:
+    """With the COM on the line through two attachments, the body tilts about that line at no cost
+    and every tilt is a rest pose: take the one nearest the file's orientation (the identity).
+
+    Turning by a about the unit axis n, tr(Rot(n, a) R) = tr R + a' sin a + c' (1 - cos a) with
+    a' = tr(K R), c' = tr(K^2 R), K = [n]x; its maximum (the smallest turn from the identity) is at
+    a = atan2(a', -c'). Other rigs are returned unchanged.
+    """
+    if len(rig.wires) != 2:
+        return rotation
+    pts = attachments(rig, com, rotation)
+    axis = pts[1] - pts[0]
+    axis /= np.linalg.norm(axis)
+    offset = (com - pts[0]) - ((com - pts[0]) @ axis) * axis
+    if np.linalg.norm(offset) > 1e-12 * max(lengths(rig).max(), 1.0):
+        return rotation
+    K = np.array([[0.0, -axis[2], axis[1]], [axis[2], 0.0, -axis[0]], [-axis[1], axis[0], 0.0]])
+    angle = np.arctan2(np.trace(K @ rotation), -np.trace(K @ K @ rotation))
+    return Rotation.from_rotvec(angle * axis).as_matrix() @ rotation
 
 
 def taut_shift(rig: Rig, com: np.ndarray, rotation: np.ndarray) -> np.ndarray:

@@ -57,3 +57,10 @@ def test_initial_velocity_is_the_least_norm_one_that_keeps_lengths():
     np.testing.assert_allclose(residual, 0.0, atol=1e-13)
     np.testing.assert_allclose(s.omega, r.initial_omega)
     assert np.abs(length_errors(r, s.com, s.rotation)).max() < 1e-12
+
+
+def test_neutral_tilt_rests_in_the_files_orientation():
+    """The thin plate's COM is on CD: every tilt about CD is a rest pose; the file's one is chosen."""
+    rest = rest_pose(rig("sidesway"))
+    np.testing.assert_allclose(rest.rotation, np.eye(3), atol=1e-12)
+    np.testing.assert_allclose(rest.com, 0.0, atol=1e-12)

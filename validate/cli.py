@@ -13,6 +13,8 @@ import sys
 
 from bifilar.rig import RigError, load_rig
 
+from . import identify_cli
+
 
 class UsageError(Exception):
     """Bad command-line input; printed as one line, exit status 2."""
@@ -65,6 +67,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--rtol", type=_positive_float("--rtol"), default=1e-10)
     p.add_argument("--out", required=True, metavar="FILE.csv")
     p.add_argument("--rerun", metavar="FILE.rrd", help="also write a rerun recording of the run (open: rerun FILE.rrd)")
+
+    identify_cli.add_parser(sub)
     return parser
 
 
@@ -177,4 +181,5 @@ _COMMANDS = {
     "case": _cmd_case,
     "modes": _cmd_modes,
     "simulate": _cmd_simulate,
+    "identify": identify_cli.run,
 }

@@ -1,0 +1,309 @@
+"""A moment of inertia from a measured period: the thesis's ch. 7.1, done with the exact linearisation.
+
+One moment is unknown: J = e^T I e about a body axis e (a unit vector in the body frame; ``x``, ``y``,
+``z`` name the body axes, for which J is the diagonal entry I_xx, I_yy or I_zz). The tensor varies
+only along e, I(J) = I + (J - e^T I e) e e^T: the other entries are held, and for a principal axis e
+only that principal moment changes. A measured period of the mode that turns about e then fixes J.
+
+Exact and cheap. At rest the stiffness K of :func:`bifilar.modes.linearize` holds gravity and the
+wires only, and the mass matrix is linear in the inertia, so with the rest pose computed once
+
+    M(J) = M(J0) + (J - J0) w w^T,   w = G_new^T R e,
+
+(G_new: partial angular velocities of the four independent speeds, R: rest rotation body -> world).
+Every period at every J is then a 4x4 generalised eigenproblem with all four modes and their coupling;
+nothing is truncated as in the thesis's 2x2 systems.
+
+Which mode belongs to the axis. For K v = w2 M v with v^T M v = 1, Hellmann-Feynman gives
+
+    d ln T / d ln J = J (w . v)^2 / 2 =: s,
+
+half the share of the mode's kinetic energy stored by the moment about e: the rotation shape's
+component along the body axis, weighed in kinetic energy (a swing with a small but pure rotation
+about e has a small share). The mode associated with the axis is the one with the largest share; its
+period is also the one that determines J best. Modes are followed continuously from the rig's own J0
+(each step takes the mode of largest M-overlap with the previous one, never the same index in a
+sorted list) by Newton's method on ln T(ln(J - J_min)), to the measured period. Since M grows with J,
+a followed period never decreases and its root is unique. Every mode of J0 is followed, because a
+strongly coupled rig can hand the rotation about e from one mode to another as J moves; a root counts
+where the followed mode has the largest share there. No root, or several, and the period is refused.
+
+Amplitude. A period measured at a finite amplitude differs from the linear one; the Kane model,
+released at the stated amplitude along the mode, gives the ratio T(A)/T(0) that maps it back
+(:func:`amplitude_ratio`, :func:`identify`). The amplitude is the peak rotation about the axis, where
+the body is let go.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+import numpy as np
+from scipy.linalg import eigh
+from scipy.spatial.transform import Rotation
+
+from . import kane_kernel as K
+from .kane import KaneModel
+from .modes import NEUTRAL_RTOL, Modes, linearize
+from .periods import period as crossing_period
+from .rig import Rig, RigError
+from .simulate import simulate
+from .statics import Rest, State, taut_shift
+
+AXES = {"x": np.array([1.0, 0.0, 0.0]), "y": np.array([0.0, 1.0, 0.0]), "z": np.array([0.0, 0.0, 1.0])}
+
+_STEP = 0.05  # first Newton step limit in ln(J - J_min): 5 %, small enough to follow a mode by overlap
+_OVERLAP = 0.99  # |v_new^T M v_old| above which the step limit may double (up to 1 in ln J)
+_REACH = np.log(1e6)  # J - J_min is searched within a factor 1e6 of the rig's own value
+_MAX_STEPS = 2 * int(_REACH / _STEP)  # enough to cross the search range twice at the smallest limit
+_TOL = 1e-13  # |ln T - ln T_measured| at the root: rounding of a 4x4 eigenproblem
+_ROUNDING = 1e3 * np.finfo(float).eps  # eigh's absolute error on w2, relative to the largest w2
+# Amplitude correction: the fixed point J -> J(T / ratio(J)) contracts by ~A^2 per pass.
+_AMPLITUDE_RTOL = 1e-9
+_AMPLITUDE_PASSES = 8
+_CYCLES = 8  # periods simulated to measure T(A): crossing times fitted over 8 cycles
+_SAMPLES_PER_PERIOD = 100  # crossing refinement is good to ~1e-10 of the period at this rate
+# Integrator tolerance: the angles are O(1) rad, so the local error rtol is an error of rtol / A
+# relative to an oscillation of amplitude A; it is kept below 1e-6 of the amplitude.
+_RTOL = 1e-10
+_RTOL_PER_RAD = 1e-6
+
+
+def axis_vector(axis) -> np.ndarray:
+    """A unit body-frame vector from ``x``, ``y``, ``z`` or any non-zero 3-vector."""
+    e = AXES[axis] if isinstance(axis, str) else np.asarray(axis, dtype=float)
+    return e / np.linalg.norm(e)
+
+
+def moment(rig: Rig, axis) -> float:
+    """J = e^T I e, the moment of inertia about the body axis (kg m^2)."""
+    e = axis_vector(axis)
+    return float(e @ rig.inertia @ e)
+
+
+def with_moment(rig: Rig, axis, value: float) -> Rig:
+    """The rig with its moment about the body axis set to ``value``, the rest of the tensor held."""
+    e = axis_vector(axis)
+    return replace(rig, inertia=rig.inertia + (value - e @ rig.inertia @ e) * np.outer(e, e))
+
+
+@dataclass(frozen=True)
+class Pencil:
+    """The linearised rig as a function of the moment J about one body axis: K v = w2 M(J) v."""
+
+    axis: np.ndarray  # e, body frame
+    lin: Modes  # at the rig's own moment J0
+    rotation: np.ndarray  # rest pose, body -> world (the frame of lin.mass)
+    partial_com: np.ndarray  # V_new (3x4): COM velocity (world) per independent speed
+    partial_omega: np.ndarray  # G_new (3x4): angular velocity (world) per independent speed
+    moment0: float  # J0
+    floor: float  # J_min: I(J) is positive definite for J > J_min
+
+    @property
+    def w(self) -> np.ndarray:
+        """G_new^T R e: angular velocity about the axis per independent speed."""
+        return self.partial_omega.T @ (self.rotation @ self.axis)
+
+    def mass(self, value: float) -> np.ndarray:
+        return self.lin.mass + (value - self.moment0) * np.outer(self.w, self.w)
+
+    def modes(self, value: float):
+        """(w2, v) of the oscillating modes at moment ``value``, longest period first: v M-normalised,
+        neutral modes dropped."""
+        w2, v = eigh(self.lin.stiffness, self.mass(value))
+        keep = w2 > NEUTRAL_RTOL * max(abs(w2).max(), 1e-300)
+        return w2[keep], v[:, keep]
+
+    def shares(self, value: float, v: np.ndarray) -> np.ndarray:
+        """Kinetic share of the moment about the axis in each mode (columns of v, M-normalised)."""
+        return value * (self.w @ v) ** 2
+
+    def associated(self, value: float):
+        """(k, w2, v): :meth:`modes` at ``value`` and the index of the one with the largest share."""
+        w2, v = self.modes(value)
+        return int(np.argmax(self.shares(value, v))), w2, v
+
+
+def pencil(rig: Rig, axis, rest: Rest | None = None) -> Pencil:
+    """Linearise the rig once (about ``rest``, default its computed rest pose) for any moment about
+    ``axis``."""
+    model = KaneModel.from_rig(rig)
+    lin = linearize(model, rest)
+    kin = K.kinematics(lin.theta0, np.zeros(5), model.p, lin.chart)
+    # linearize's inertia in world axes is R I R^T, R = (n~ frame) frame_in_body^T
+    rotation = kin[1] @ model.frame_in_body.T
+    e = axis_vector(axis)
+    j0 = moment(rig, e)
+    floor = j0 - 1.0 / float(e @ np.linalg.solve(rig.inertia, e))
+    return Pencil(e, lin, rotation, kin[3] @ lin.tangent, kin[4] @ lin.tangent, j0, floor)
+
+
+@dataclass(frozen=True)
+class Identified:
+    """The moment (kg m^2) about ``axis`` whose associated mode has the linear ``period`` (s).
+
+    ``sensitivity`` is d ln T / d ln J of that mode at the solution (1/2 for a pure rotation about
+    the axis): a period error dT gives dJ / J = dT / T / sensitivity. ``amplitude_ratio`` is T(A)/T(0)
+    when a finite amplitude was corrected for, else 1.
+    """
+
+    moment: float
+    period: float
+    sensitivity: float
+    rig: Rig
+    amplitude_ratio: float = 1.0
+
+
+def _track(p: Pencil, k: int, target: float):
+    """Follow mode ``k`` of J0 continuously to ln T = ``target``: (J, index there, w2, v), or None if
+    the mode does not reach that period for J - J_min within :data:`_REACH` of J0 - J_min.
+
+    Newton steps in u = ln(J - J_min) start limited to :data:`_STEP`; the limit doubles while the
+    followed mode keeps an M-overlap of at least :data:`_OVERLAP` and falls back otherwise, so that
+    a mode that never reaches the period is walked out of range in a few steps.
+    """
+    value = p.moment0
+    w2, v = p.modes(value)
+    u0 = u = np.log(value - p.floor)
+    limit = _STEP
+    for _ in range(_MAX_STEPS):
+        residual = np.log(2.0 * np.pi) - 0.5 * np.log(w2[k]) - target  # ln T - ln T_measured
+        # eigh resolves w2[k] to ~eps * max(w2) absolutely: a slow mode beside fast ones is known to less.
+        if abs(residual) < _TOL + _ROUNDING * w2.max() / w2[k]:
+            return value, k, w2, v
+        slope = 0.5 * (p.w @ v[:, k]) ** 2 * (value - p.floor)  # d ln T / du
+        step = -residual / slope if slope > 0.0 else -np.sign(residual) * limit
+        u += float(np.clip(step, -limit, limit))
+        if abs(u - u0) > _REACH:
+            return None
+        value = p.floor + np.exp(u)
+        previous = v[:, k]
+        w2, v = p.modes(value)
+        overlap = np.abs(v.T @ p.mass(value) @ previous)
+        k = int(np.argmax(overlap))
+        limit = min(2.0 * limit, 1.0) if overlap[k] >= _OVERLAP else _STEP
+    return None
+
+
+def invert_period(rig: Rig, axis, period: float, rest: Rest | None = None, p: Pencil | None = None) -> Identified:
+    """The moment about ``axis`` for which the mode associated with the axis has ``period``.
+
+    Every oscillating mode of J0 is followed to the period (a strongly coupled rig can hand the
+    rotation about the axis from one mode to another as J moves); a solution counts where the
+    followed mode has the largest kinetic share about the axis. Raises :class:`RigError`: field
+    ``axis`` if no mode turns about the axis, field ``period`` if no solution or several exist.
+    """
+    p = pencil(rig, axis, rest) if p is None else p
+    src, name = rig.source, _fmt(p.axis)
+    w2, v = p.modes(p.moment0)
+    if p.shares(p.moment0, v).max() < 1e-12:
+        raise RigError(src, "axis", f"no oscillating mode turns about body axis {name}: its moment cannot be "
+                                    "measured by timing this rig")
+    target = np.log(period)
+    found = {}
+    for k in range(len(w2)):
+        hit = _track(p, k, target)
+        if hit is not None and p.associated(hit[0])[0] == hit[1]:
+            found[round(hit[0], 9 - int(np.floor(np.log10(hit[0]))))] = hit
+    if not found:
+        raise RigError(src, "period", f"{period:.9g} s: no moment about {name} within a factor 1e6 of the "
+                                      f"rig's {p.moment0:.6g} kg m^2 gives the mode turning about it this period")
+    if len(found) > 1:
+        raise RigError(src, "period", f"{period:.9g} s is ambiguous: moments {', '.join(f'{j:.6g}' for j in found)} "
+                                      f"kg m^2 about {name} all give it")
+    value, k, w2, v = next(iter(found.values()))
+    sensitivity = float(0.5 * p.shares(value, v[:, k:k + 1])[0])
+    return Identified(float(value), float(2.0 * np.pi / np.sqrt(w2[k])), sensitivity, with_moment(rig, p.axis, value))
+
+
+def linear_period(rig: Rig, axis, rest: Rest | None = None) -> float:
+    """Small-amplitude period (s) of the mode associated with ``axis`` at the rig's own inertia."""
+    p = pencil(rig, axis, rest)
+    k, w2, _ = p.associated(p.moment0)
+    return float(2.0 * np.pi / np.sqrt(w2[k]))
+
+
+@dataclass(frozen=True)
+class Release:
+    """The rig let go from rest displaced along the mode associated with an axis (:func:`released`)."""
+
+    model: KaneModel
+    state: State
+    period: float  # the mode's linear period, s
+    rest_rotation: np.ndarray  # body -> world at rest
+    axis_world: np.ndarray  # the axis at rest, world frame
+
+
+def released(rig: Rig, axis, amplitude: float, rest: Rest | None = None) -> Release:
+    """An experimenter's start: the body turned about ``axis`` by ``amplitude`` (rad) and let go.
+
+    The rest pose is displaced by the associated mode's linear shape, scaled so that the rotation
+    vector's component along the axis is ``amplitude``, then moved the shortest way onto the taut-wire
+    poses (:func:`bifilar.statics.taut_shift`). Every speed is zero, so the rotation about the axis
+    starts at its turning point: the amplitude is the peak rotation. For a mode that only turns about
+    the axis (the torsion of a symmetric rig) this is exactly the 1-DOF motion of :mod:`bifilar.lagrange`.
+    """
+    p = pencil(rig, axis, rest)
+    k, w2, v = p.associated(p.moment0)
+    axis_world = p.rotation @ p.axis
+    turn, shift = p.partial_omega @ v[:, k], p.partial_com @ v[:, k]
+    scale = amplitude / (turn @ axis_world)
+    rotation = Rotation.from_rotvec(scale * turn).as_matrix() @ p.rotation
+    com = p.lin.rest.com + scale * shift
+    com = com + taut_shift(rig, com, rotation)
+    state = State(com, rotation, np.zeros(3), np.zeros(3))
+    return Release(KaneModel.from_rig(rig), state, float(2.0 * np.pi / np.sqrt(w2[k])), p.rotation, axis_world)
+
+
+def simulated_period(rig: Rig, axis, amplitude: float, rest: Rest | None = None) -> float:
+    """The period (s) the Kane model shows for the mode associated with ``axis`` at ``amplitude``.
+
+    From :func:`released`, :data:`_CYCLES` cycles are integrated and the period is the mean interval
+    of the crossings of the rotation angle about the axis (:func:`bifilar.periods.period`).
+    """
+    start = released(rig, axis, amplitude, rest)
+    rtol = min(_RTOL, _RTOL_PER_RAD * amplitude)
+    run = simulate(start.model, start.state, _CYCLES * start.period, dt_out=start.period / _SAMPLES_PER_PERIOD,
+                   rtol=rtol)
+    if run.slack is not None:
+        wire, t = run.slack
+        raise RigError(rig.source, "amplitude", f"{amplitude:g} rad: wire[{wire}] goes slack at t = {t:.4g} s")
+    turned = Rotation.from_matrix(run.rotation @ start.rest_rotation.T).as_rotvec() @ start.axis_world
+    return crossing_period(run.t, turned).value
+
+
+def amplitude_ratio(rig: Rig, axis, amplitude: float, rest: Rest | None = None) -> float:
+    """T(A) / T(0) of the mode associated with ``axis``: :func:`simulated_period` over
+    :func:`linear_period`."""
+    return simulated_period(rig, axis, amplitude, rest) / linear_period(rig, axis, rest)
+
+
+def identify(rig: Rig, axis, period: float, amplitude: float = 0.0, rest: Rest | None = None) -> Identified:
+    """The moment about ``axis`` from a ``period`` measured at rotation ``amplitude`` (rad; 0: small).
+
+    With an amplitude, the fixed point J = invert(T / ratio(J)) is iterated (:func:`amplitude_ratio`
+    at the current J); it contracts by ~A^2 per pass.
+    """
+    p = pencil(rig, axis, rest)
+    result = invert_period(rig, axis, period, rest, p)
+    if amplitude == 0.0:
+        return result
+    for _ in range(_AMPLITUDE_PASSES):
+        ratio = amplitude_ratio(result.rig, axis, amplitude, rest)
+        new = invert_period(rig, axis, period / ratio, rest, p)
+        done = abs(new.moment / result.moment - 1.0) < _AMPLITUDE_RTOL
+        result = replace(new, amplitude_ratio=ratio)
+        if done:
+            return result
+    raise RigError(rig.source, "amplitude", f"{amplitude:g} rad: the amplitude correction did not converge")
+
+
+def amplitude_coefficient(rig: Rig, axis, rest: Rest | None = None, amplitude: float = 0.05) -> float:
+    """c in T(A) = T(0) (1 + c A^2 + O(A^4)) (1/rad^2), from :func:`amplitude_ratio` at ``amplitude``
+    (0.05 rad: the O(A^4) term changes c by ~A^2 of itself, the crossing-time error ~1e-9 / A^2)."""
+    return (amplitude_ratio(rig, axis, amplitude, rest) - 1.0) / amplitude**2
+
+
+def _fmt(e: np.ndarray) -> str:
+    names = [n for n, a in AXES.items() if np.allclose(a, e)]
+    return names[0] if names else "[" + ", ".join(f"{x:.6g}" for x in e) + "]"
