@@ -13,7 +13,7 @@ import sys
 
 from bifilar.rig import RigError, load_rig
 
-from . import identify_cli
+from . import boat_cli, identify_cli
 
 
 class UsageError(Exception):
@@ -69,6 +69,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--rerun", metavar="FILE.rrd", help="also write a rerun recording of the run (open: rerun FILE.rrd)")
 
     identify_cli.add_parser(sub)
+    boat_cli.add_parser(sub)
     return parser
 
 
@@ -182,4 +183,5 @@ _COMMANDS = {
     "modes": _cmd_modes,
     "simulate": _cmd_simulate,
     "identify": identify_cli.run,
+    "boat": boat_cli.run,
 }

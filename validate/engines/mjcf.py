@@ -222,20 +222,24 @@ def add_scene(spec: mujoco.MjSpec, rig: Rig, rest: Rest | None = None) -> None:
 def write_model_files(rig: Rig, directory: str | Path) -> tuple[Path, Path]:
     """Write ``<rig.name>.xml`` (tendon cables, chosen numerics) and ``scene.xml``, which includes it
     and adds the scene, so that ``python -m mujoco.viewer --mjcf <directory>/scene.xml`` opens it."""
+    rest = rest_pose(rig)
+    return write_xml_pair(build_spec(rig, rest=rest), f"{rig.name}.xml", lambda spec: add_scene(spec, rig, rest),
+                          directory)
+
+
+def write_xml_pair(model: mujoco.MjSpec, model_file: str, scene, directory: str | Path) -> tuple[Path, Path]:
+    """Write ``model`` to ``directory/model_file`` and ``scene.xml``, an MJCF that includes it and holds
+    what ``scene(spec)`` adds to an empty spec (floor, light, ceiling). Full precision, as written."""
     directory = Path(directory)
     directory.mkdir(parents=True, exist_ok=True)
-    rest = rest_pose(rig)
-    model_spec = build_spec(rig, rest=rest)
-    model_path = directory / f"{rig.name}.xml"
-    model_path.write_text(model_spec.to_xml())
-
+    model_path = directory / model_file
+    model_path.write_text(model.to_xml())
     scene_spec = mujoco.MjSpec()
-    scene_spec.modelname = f"{rig.name} scene"
+    scene_spec.modelname = f"{Path(model_file).stem} scene"
     scene_spec.compiler.savecompiled = False
     scene_spec.compiler.savecanonical = False
-    add_scene(scene_spec, rig, rest)
-    scene_xml = scene_spec.to_xml()
-    head, sep, tail = scene_xml.partition(">\n")
+    scene(scene_spec)
+    head, sep, tail = scene_spec.to_xml().partition(">\n")
     scene_path = directory / "scene.xml"
     scene_path.write_text(f'{head}{sep}  <include file="{model_path.name}"/>\n\n{tail}')
     return model_path, scene_path
