@@ -16,8 +16,6 @@ Regenerate after changing the parts or the hall:
 
 from __future__ import annotations
 
-import argparse
-import sys
 from pathlib import Path
 
 import mujoco
@@ -25,7 +23,6 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from bifilar.boat import Suspension, load_suspension
-from bifilar.rig import RigError
 from bifilar.statics import Rest, rest_pose
 
 from .engines import mjcf
@@ -97,18 +94,8 @@ def write_model_files(s: Suspension, directory: str | Path) -> tuple[Path, Path]
 
 def main(argv: list[str] | None = None) -> int:
     """``python -m validate.boat_model SUSPENSION.toml DIR``: write DIR/boat.xml and DIR/scene.xml."""
-    parser = argparse.ArgumentParser(description=main.__doc__)
-    parser.add_argument("suspension", help="suspension file (TOML), e.g. models/solar_boat/suspension.toml")
-    parser.add_argument("directory", help="output folder")
-    args = parser.parse_args(argv)
-    try:
-        paths = write_model_files(load_suspension(args.suspension), args.directory)
-    except RigError as exc:
-        print(f"error: {exc}", file=sys.stderr)
-        return 2
-    for path in paths:
-        print(path)
-    return 0
+    return mjcf.xml_main(argv, main.__doc__, "suspension file (TOML), e.g. models/solar_boat/suspension.toml",
+                         lambda path, out: write_model_files(load_suspension(path), out))
 
 
 if __name__ == "__main__":

@@ -310,14 +310,20 @@ def _header(rig: Rig, cables: str, numerics: Numerics) -> str:
 
 def main(argv: list[str] | None = None) -> int:
     """``python -m validate.engines.mjcf RIG.toml DIR``: write the rig's model and scene XML."""
-    parser = argparse.ArgumentParser(description=main.__doc__)
-    parser.add_argument("rig", help="rig file (TOML)")
-    parser.add_argument("directory", help="output folder for <name>.xml and scene.xml")
+    return xml_main(argv, main.__doc__, "rig file (TOML)", lambda path, out: write_model_files(load_rig(path), out))
+
+
+def xml_main(argv, description: str, input_help: str, write) -> int:
+    """A command line ``INPUT DIR`` that calls ``write(INPUT, DIR)`` and prints the files written; a
+    bad input is one line on stderr and exit status 2."""
+    parser = argparse.ArgumentParser(description=description)
+    parser.add_argument("input", help=input_help)
+    parser.add_argument("directory", help="output folder")
     args = parser.parse_args(argv)
     try:
-        paths = write_model_files(load_rig(args.rig), args.directory)
+        paths = write(args.input, args.directory)
     except RigError as exc:
-        print(exc, file=sys.stderr)
+        print(f"error: {exc}", file=sys.stderr)
         return 2
     for path in paths:
         print(path)
