@@ -41,6 +41,7 @@ KINDS = ("angle", "rate")
 PARAMETERS = ("omega", "zeta", "quadratic", "theta0", "rate0", "offset", "drift")
 MIN_SAMPLES = 20  # seven parameters, and enough residual degrees of freedom to estimate the noise
 MIN_CYCLES = 2.0  # fewer cycles in the record and the periodogram cannot locate the peak
+MIN_SNR = 3.0  # a swing whose RMS is 3x the residual is unmistakable: noise fits reach ~0.2-0.5
 # RK4 steps per period: its relative frequency error (omega h)^4 / 120 is then 3e-9, far below the
 # statistical error of any real record, and cubic Hermite interpolation is of the same order.
 _STEPS_PER_PERIOD = 256
@@ -155,6 +156,13 @@ def fit_oscillation(t, y, kind: str, amplitude_coefficient: float = 0.0) -> Osci
         return _response(p, kappa, tau, step, rate_out) - y
 
     sol = least_squares(residual, x0, x_scale="jac", method="trf", xtol=1e-12, ftol=1e-12, gtol=1e-12)
+    # A record of noise alone also yields a "best" period: refuse one whose oscillation does not stand
+    # out of the residual (the fitted swing's RMS below MIN_SNR times the residual's).
+    swing = sol.fun + y - sol.x[5] - sol.x[6] * tau
+    snr = float(np.sqrt(np.mean(swing**2)) / max(np.sqrt(np.mean(sol.fun**2)), 1e-300))
+    if snr < MIN_SNR:
+        raise ValueError(f"no oscillation stands out of the noise (fitted swing / residual RMS = {snr:.2g} "
+                         f"< {MIN_SNR:g})")
     dof = len(y) - len(x0)
     variance = 2.0 * sol.cost / dof
     _, sv, vt = np.linalg.svd(sol.jac, full_matrices=False)

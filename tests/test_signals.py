@@ -154,3 +154,11 @@ def test_csv_errors_name_file_column_and_problem(tmp_path, text, field, problem)
 def test_csv_missing_file(tmp_path):
     with pytest.raises(RigError, match="file: cannot read"):
         S.read_csv(tmp_path / "absent.csv", "yaw")
+
+
+def test_noise_alone_is_refused():
+    """White noise has a "best" period too; the fit must say there is no oscillation instead."""
+    rng = np.random.default_rng(0)
+    t = np.arange(0.0, 30.0, 0.02)
+    with pytest.raises(ValueError, match="no oscillation stands out of the noise"):
+        S.fit_oscillation(t, 0.01 + 1e-3 * rng.standard_normal(t.size), "angle")
