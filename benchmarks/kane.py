@@ -6,14 +6,13 @@ Run: python benchmarks/kane.py   (numbers vary with machine load: compare ratios
 
 from __future__ import annotations
 
-
 import numpy as np
+from timing import best_of
 
 from bifilar import kane_kernel as K
 from bifilar.kane import KaneModel
 from bifilar.simulate import preferred_chart, simulate, state_to_chart
 from bifilar.statics import initial_state
-from timing import best_of
 from validate.assets import rig
 
 

@@ -12,6 +12,7 @@ from dataclasses import replace
 from pathlib import Path
 
 from timing import best_of
+
 from validate.assets import rig
 from validate.engines import kane
 from validate.recording import record, record_trajectory

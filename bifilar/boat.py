@@ -22,7 +22,16 @@ from pathlib import Path
 
 import numpy as np
 
-from .checks import RigError, no_unknown, non_negative, positive, read_toml, required, table, vector3
+from .checks import (
+    RigError,
+    no_unknown,
+    non_negative,
+    positive,
+    read_toml,
+    required,
+    table,
+    vector3,
+)
 from .composite import MassProperties, Part, load_parts, mass_properties, rig_body
 from .rig import Rig, rig_from_dict
 

@@ -24,7 +24,6 @@ from pathlib import Path
 from typing import Callable
 
 import numpy as np
-
 from scipy.spatial.transform import Rotation
 
 from .checks import RigError, no_unknown, positive, read_toml, required, vector3

@@ -7,8 +7,8 @@ from pathlib import Path
 
 import mujoco
 import numpy as np
-from scipy.spatial.transform import Rotation
 import pytest
+from scipy.spatial.transform import Rotation
 
 from bifilar.composite import (
     SHAPES,

@@ -15,7 +15,15 @@ from scipy.spatial.transform import Rotation
 
 from validate.assets import rig
 from validate.engines import kane
-from validate.recording import SLACK_RGB, VIRIDIS, inertia_box, record, record_case, record_trajectory, tension_colors
+from validate.recording import (
+    SLACK_RGB,
+    VIRIDIS,
+    inertia_box,
+    record,
+    record_case,
+    record_trajectory,
+    tension_colors,
+)
 from validate.registry import check
 from validate.suite import CaseResult
 from validate.trajectory import Trajectory

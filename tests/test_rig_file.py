@@ -121,3 +121,15 @@ def test_simulate_rejects_unknown_engine_and_bad_duration(tmp_path, capsys):
                            "--out", str(tmp_path / "x.csv"))
     assert code == 2 and "--duration" in err
     assert not (tmp_path / "x.csv").exists()
+
+
+def test_mujoco_output_step_must_be_whole_time_steps(tmp_path, capsys):
+    code, _, err = run_cli(capsys, "simulate", str(RIGS / "plate.toml"), "--engine", "mujoco", "--duration", "0.1",
+                           "--dt-out", "0.0123457", "--out", str(tmp_path / "x.csv"))
+    assert code == 2 and err.startswith("error: --dt-out: ") and err.count("\n") == 1
+    assert not (tmp_path / "x.csv").exists()
+
+
+def test_jobs_must_be_positive(capsys):
+    code, _, err = run_cli(capsys, "all", "--jobs", "0")
+    assert code == 2 and "--jobs must be at least 1" in err

@@ -38,6 +38,19 @@ def _positive_float(name: str):
     return parse
 
 
+def _positive_int(name: str):
+    def parse(text: str) -> int:
+        try:
+            value = int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{name} must be a whole number, got {text!r}") from None
+        if value < 1:
+            raise argparse.ArgumentTypeError(f"{name} must be at least 1, got {value}")
+        return value
+
+    return parse
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = _Parser(prog="python -m validate", description=__doc__.splitlines()[0])
     sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
@@ -45,7 +58,7 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("all", help="run every registered validation case")
     p.add_argument("--json", metavar="REPORT.json", help="also write the report as JSON")
     p.add_argument("--slow", action="store_true", help="include cases tagged slow")
-    p.add_argument("--jobs", type=int, default=2, help="cases run in parallel (default 2)")
+    p.add_argument("--jobs", type=_positive_int("--jobs"), default=2, help="cases run in parallel (default 2)")
     p.add_argument("--rerun", metavar="DIR", help="also write one rerun recording per case, DIR/<case>.rrd")
 
     sub.add_parser("list", help="list the registered cases")
@@ -113,14 +126,17 @@ def _cmd_modes(args) -> int:
 
 
 def _cmd_simulate(args) -> int:
-    from .engines import engines
+    from .engines import EngineInputError, engines
     from .trajectory import write_rig_csv
 
     available = engines()
     if args.engine not in available:
         raise UsageError(f"--engine: unknown engine {args.engine!r} (choose from {', '.join(available)})")
     rig = load_rig(args.rig)
-    traj = available[args.engine](rig, args.duration, args.dt_out, args.rtol)
+    try:
+        traj = available[args.engine](rig, args.duration, args.dt_out, args.rtol)
+    except EngineInputError as exc:
+        raise UsageError(f"--dt-out: {exc}") from None
     write_rig_csv(traj, args.out)
     if args.rerun:
         from .recording import record_trajectory

@@ -3,8 +3,8 @@
 from __future__ import annotations
 
 import numpy as np
-from scipy.special import ellipk
 from scipy.spatial.transform import Rotation
+from scipy.special import ellipk
 
 from bifilar.kane import POLAR, TILT, KaneModel
 from bifilar.modes import excite, linearize

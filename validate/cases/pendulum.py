@@ -13,8 +13,8 @@ from __future__ import annotations
 import mujoco
 import numpy as np
 from scipy.integrate import quad, solve_ivp
-from scipy.special import ellipk
 from scipy.spatial.transform import Rotation
+from scipy.special import ellipk
 
 from ..metrics import channel_difference, max_abs, period
 from ..registry import CaseContext, case, check

@@ -21,6 +21,11 @@ from ..trajectory import Trajectory
 EngineRun = Callable[[Rig, float, float, float], Trajectory]
 
 
+class EngineInputError(ValueError):
+    """A run request an engine cannot honour (e.g. an output step that is not a whole number of its
+    time steps); the command line reports it as bad input."""
+
+
 def engines() -> dict[str, EngineRun]:
     """Engine name -> run function (imported lazily so that one engine's import cost is paid only
     when it is used)."""

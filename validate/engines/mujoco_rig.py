@@ -24,7 +24,7 @@ from bifilar.rig import Rig
 from bifilar.statics import State, initial_state
 
 from ..trajectory import Trajectory
-from . import mjcf
+from . import EngineInputError, mjcf
 from .mjcf import CHOSEN, Numerics
 
 
@@ -59,7 +59,7 @@ def simulate(model: mujoco.MjModel, rig: Rig, state: State, duration: float, dt_
     """
     nstep = round(dt_out / model.opt.timestep)
     if nstep < 1 or abs(nstep * model.opt.timestep - dt_out) > 1e-9 * dt_out:
-        raise ValueError(f"dt_out = {dt_out:g} s is not a whole number of time steps ({model.opt.timestep:g} s)")
+        raise EngineInputError(f"dt_out = {dt_out:g} s is not a whole number of time steps ({model.opt.timestep:g} s)")
     n_out = int(np.floor(duration / dt_out + 1e-9)) + 1
     data = mujoco.MjData(model)
     data.qpos[:], data.qvel[:] = mjcf.state_qpos_qvel(rig, state)
