@@ -9,12 +9,15 @@ few thousand points to some tens of kB.
 
 from __future__ import annotations
 
+import io
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 from PIL import Image, ImageDraw, ImageFont
+
+from .trajectory import atomic_write_bytes
 
 WIDTH = 960  # px
 PANEL_HEIGHT = 250  # px, plotting area and title of one panel
@@ -99,8 +102,9 @@ def save_png(path: str | Path, panels: list[Panel], xlabel: str) -> Path:
         _legend(draw, font, panel, box)
     draw.text((WIDTH - right, height - 8), xlabel, fill=AXIS_RGB, font=font, anchor="rb")
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    image.quantize(colors=64).save(path, optimize=True)
+    png = io.BytesIO()
+    image.quantize(colors=64).save(png, format="PNG", optimize=True)
+    atomic_write_bytes(path, png.getvalue())
     return path
 
 

@@ -37,6 +37,8 @@ from scipy.spatial.transform import Rotation
 from bifilar.rig import Rig, RigError, load_rig
 from bifilar.statics import Rest, State, attachments, initial_state, rest_pose
 
+from ..trajectory import atomic_write_text
+
 CABLES = ("tendon", "equality")
 
 _INTEGRATORS = {
@@ -233,7 +235,7 @@ def write_xml_pair(model: mujoco.MjSpec, model_file: str, scene, directory: str 
     directory = Path(directory)
     directory.mkdir(parents=True, exist_ok=True)
     model_path = directory / model_file
-    model_path.write_text(model.to_xml())
+    atomic_write_text(model_path, model.to_xml())
     scene_spec = mujoco.MjSpec()
     scene_spec.modelname = f"{Path(model_file).stem} scene"
     scene_spec.compiler.savecompiled = False
@@ -241,7 +243,7 @@ def write_xml_pair(model: mujoco.MjSpec, model_file: str, scene, directory: str 
     scene(scene_spec)
     head, sep, tail = scene_spec.to_xml().partition(">\n")
     scene_path = directory / "scene.xml"
-    scene_path.write_text(f'{head}{sep}  <include file="{model_path.name}"/>\n\n{tail}')
+    atomic_write_text(scene_path, f'{head}{sep}  <include file="{model_path.name}"/>\n\n{tail}')
     return model_path, scene_path
 
 
