@@ -8,12 +8,12 @@ from __future__ import annotations
 
 import argparse
 import json
-import math
 import sys
 
 from bifilar.rig import RigError, load_rig
 
 from . import boat_cli, identify_cli
+from .argtypes import positive_float, whole_number
 
 
 class UsageError(Exception):
@@ -25,32 +25,6 @@ class _Parser(argparse.ArgumentParser):
         raise UsageError(f"{self.prog}: {message}")
 
 
-def _positive_float(name: str):
-    def parse(text: str) -> float:
-        try:
-            value = float(text)
-        except ValueError:
-            raise argparse.ArgumentTypeError(f"{name} must be a number, got {text!r}") from None
-        if not math.isfinite(value) or value <= 0.0:
-            raise argparse.ArgumentTypeError(f"{name} must be a positive finite number, got {text!r}")
-        return value
-
-    return parse
-
-
-def _positive_int(name: str):
-    def parse(text: str) -> int:
-        try:
-            value = int(text)
-        except ValueError:
-            raise argparse.ArgumentTypeError(f"{name} must be a whole number, got {text!r}") from None
-        if value < 1:
-            raise argparse.ArgumentTypeError(f"{name} must be at least 1, got {value}")
-        return value
-
-    return parse
-
-
 def build_parser() -> argparse.ArgumentParser:
     parser = _Parser(prog="python -m validate", description=__doc__.splitlines()[0])
     sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
@@ -58,7 +32,7 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("all", help="run every registered validation case")
     p.add_argument("--json", metavar="REPORT.json", help="also write the report as JSON")
     p.add_argument("--slow", action="store_true", help="include cases tagged slow")
-    p.add_argument("--jobs", type=_positive_int("--jobs"), default=2, help="cases run in parallel (default 2)")
+    p.add_argument("--jobs", type=whole_number("--jobs", 1), default=2, help="cases run in parallel (default 2)")
     p.add_argument("--rerun", metavar="DIR", help="also write one rerun recording per case, DIR/<case>.rrd")
 
     sub.add_parser("list", help="list the registered cases")
@@ -75,9 +49,9 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("simulate", help="simulate a rig and write the trajectory CSV")
     p.add_argument("rig")
     p.add_argument("--engine", default="kane")
-    p.add_argument("--duration", type=_positive_float("--duration"), required=True)
-    p.add_argument("--dt-out", type=_positive_float("--dt-out"), default=0.01)
-    p.add_argument("--rtol", type=_positive_float("--rtol"), default=1e-10)
+    p.add_argument("--duration", type=positive_float("--duration"), required=True)
+    p.add_argument("--dt-out", type=positive_float("--dt-out"), default=0.01)
+    p.add_argument("--rtol", type=positive_float("--rtol"), default=1e-10)
     p.add_argument("--out", required=True, metavar="FILE.csv")
     p.add_argument("--rerun", metavar="FILE.rrd", help="also write a rerun recording of the run (open: rerun FILE.rrd)")
 

@@ -22,39 +22,29 @@ method (``linear`` or ``monte-carlo (N)``) and each uncertainty group's share of
 
 from __future__ import annotations
 
-import argparse
 import json
 
 import numpy as np
 
 from bifilar.rig import RigError, load_rig
 
+from .argtypes import positive_float, whole_number
+
 
 def add_parser(subparsers) -> None:
     """Register the ``identify`` subcommand on the CLI's subparsers."""
-    from .cli import _positive_float
 
     p = subparsers.add_parser("identify", help="a moment of inertia from a measured period, with its uncertainty")
     p.add_argument("rig")
     p.add_argument("--axis", required=True, choices=("x", "y", "z"), help="body axis of the unknown moment")
     source = p.add_mutually_exclusive_group(required=True)
-    source.add_argument("--period", type=_positive_float("--period"), help="measured period, s")
+    source.add_argument("--period", type=positive_float("--period"), help="measured period, s")
     source.add_argument("--signal", metavar="FILE.csv", help="recorded angle or rate about the axis")
-    p.add_argument("--amplitude", type=_positive_float("--amplitude"), help="peak rotation while timed, rad")
+    p.add_argument("--amplitude", type=positive_float("--amplitude"), help="peak rotation while timed, rad")
     p.add_argument("--column", help="signal column (default: the --kind)")
     p.add_argument("--kind", choices=("angle", "rate"), default="angle", help="what the signal column holds")
-    p.add_argument("--samples", type=_positive_int, help="Monte Carlo draws instead of linear propagation")
+    p.add_argument("--samples", type=whole_number("--samples", 2), help="Monte Carlo draws instead of linear propagation")
     p.add_argument("--json", action="store_true", help="print one JSON object")
-
-
-def _positive_int(text: str) -> int:
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"--samples must be an integer, got {text!r}") from None
-    if value < 2:
-        raise argparse.ArgumentTypeError(f"--samples must be at least 2, got {value}")
-    return value
 
 
 def run(args) -> int:
