@@ -25,9 +25,11 @@ def read_toml(path: str | Path) -> dict:
     """Parse a TOML file; an unreadable or malformed file is a :class:`RigError`."""
     src = str(path)
     try:
-        text = Path(path).read_text()
+        text = Path(path).read_text(encoding="utf-8")
     except OSError as exc:
         raise RigError(src, "file", f"cannot read ({exc.strerror})") from None
+    except UnicodeDecodeError as exc:
+        raise RigError(src, "file", f"not UTF-8 text (byte {exc.start})") from None
     try:
         return tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:

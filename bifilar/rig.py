@@ -11,6 +11,7 @@ that the command line can print it as one line and exit with status 2.
 
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
@@ -86,15 +87,15 @@ _UNCERTAINTY_KEYS = set(Uncertainty.__dataclass_fields__)
 def load_rig(path: str | Path) -> Rig:
     """Read and check a rig file; raise :class:`RigError` on any problem."""
     data = read_toml(path)
-    return rig_from_dict(data, source=str(path), default_name=Path(path).stem)
+    return rig_from_dict(data, source=str(path), default_name=re.sub(r"[^A-Za-z0-9_.-]", "_", Path(path).stem))
 
 
 def rig_from_dict(data: dict, source: str = "<memory>", default_name: str = "rig") -> Rig:
     """Build a checked :class:`Rig` from the parsed TOML table (see the module docstring)."""
     no_unknown(data, _TOP_KEYS, source, "")
     name = data.get("name", default_name)
-    if not isinstance(name, str) or not name:
-        raise RigError(source, "name", "must be a non-empty string")
+    if not isinstance(name, str) or not re.fullmatch(r"[A-Za-z0-9_.-]+", name) or name.startswith("."):
+        raise RigError(source, "name", "must be letters, digits, '_', '-' or '.' (it names output files)")
     gravity = positive(data.get("gravity", 9.81), source, "gravity")
 
     body = table(data, "body", source, mandatory=True)
@@ -163,11 +164,11 @@ def check_reachable(rig: Rig) -> None:
              "attachment span": span_body, "wire[2].length": w2.length}
     total = sum(sides.values())
     for label, side in sides.items():
-        if side > total - side:
+        if side >= (total - side) * (1.0 - 1e-9):  # equal is a flat loop: no sag, infinite tension
             raise RigError(
                 rig.source,
                 "wire",
-                f"no taut pose: the {label} ({side:.6g} m) exceeds the sum of the other three "
+                f"no taut pose: the {label} ({side:.6g} m) is not shorter than the sum of the other three "
                 f"sides of the anchor-wire-body loop ({total - side:.6g} m)",
             )
 

@@ -21,7 +21,7 @@ from scipy.integrate import solve_ivp
 
 from . import kane_kernel as K
 from .kane import POLAR, TILT, KaneModel, wire_angles
-from .statics import State
+from .statics import State, length_errors
 
 _ENTER_TILT = 0.1  # leave POLAR when sin(theta2) falls below this
 _ENTER_POLAR = 0.95  # leave TILT when |u . n1| rises above this
@@ -47,6 +47,28 @@ class KaneRun:
     slack: tuple[int, float] | None  # (wire number, time) where a wire went slack, else None
 
 
+class IntegrationError(RuntimeError):
+    """The integrator could not continue (step size underflow: the motion is too violent)."""
+
+
+MAX_SAMPLES = 10_000_000  # an output grid larger than this is a mistake, not a request
+
+
+def output_grid(duration: float, dt_out: float) -> np.ndarray:
+    """Sample times 0, dt_out, 2 dt_out, ... up to ``duration`` (s); the last one is clipped to
+    ``duration`` so that rounding (3 x 0.1 > 0.3) never drops it."""
+    n_out = int(np.floor(duration / dt_out + 1e-9)) + 1
+    if n_out > MAX_SAMPLES:
+        raise ValueError(f"{n_out} output samples (duration / dt_out): at most {MAX_SAMPLES}")
+    return np.minimum(np.arange(n_out) * dt_out, duration)
+
+
+def _pushing_wire(y: np.ndarray, p: np.ndarray, chart: int) -> tuple[int, float] | None:
+    """(wire, 0.0) if a wire's tension is already negative in state ``y``, else None."""
+    tension = K.loads(y[:5], y[5:], p, chart)[0]
+    return (int(np.argmin(tension)) + 1, 0.0) if tension.min() < 0.0 else None
+
+
 def state_to_chart(model: KaneModel, state: State, chart: int) -> np.ndarray:
     """(theta, theta') of a rigid-body state in the given chart."""
     theta = model.angles(state.com, state.rotation, chart)
@@ -69,23 +91,22 @@ def simulate(
 ) -> KaneRun:
     """Integrate from ``state`` for ``duration`` seconds, sampling every ``dt_out`` seconds."""
     atol = 1e-2 * rtol if atol is None else atol
-    n_out = int(np.floor(duration / dt_out + 1e-9)) + 1
-    grid = np.arange(n_out) * dt_out
+    grid = output_grid(duration, dt_out)
     p = model.p
     chart = preferred_chart(model, state)
     y = state_to_chart(model, state, chart)
-    t0 = 0.0
-    samples, charts = [], []
+    samples = []
     nfev = 0
-    slack = None
+    slack = _pushing_wire(y, p, chart)  # a wire that would already have to push: stop at t = 0
+    if slack is not None:
+        return _sampled_run(model, [(y[None, :], chart)], grid, nfev, slack)
+    t0, t_end = 0.0, float(grid[-1])
     while True:
         events = [_chart_event(chart), _slack_event(p, chart, 0), _slack_event(p, chart, 1)]
-        todo = grid[(grid >= t0) & (grid <= duration)]
-        if samples:
-            todo = todo[todo > t0]
+        todo = grid[grid > t0] if samples else grid
         sol = solve_ivp(
             lambda t, yy, c=chart: K.rhs(yy, p, c),
-            (t0, duration),
+            (t0, t_end),
             y,
             method="DOP853",
             t_eval=todo,
@@ -95,10 +116,9 @@ def simulate(
         )
         nfev += sol.nfev
         if sol.status == -1:
-            raise RuntimeError(f"kane integration failed at t = {sol.t[-1] if sol.t.size else t0}: {sol.message}")
+            raise IntegrationError(f"kane integration failed at t = {sol.t[-1] if sol.t.size else t0:.6g} s: {sol.message}")
         if sol.y.shape[1]:
             samples.append((sol.y.T, chart))
-            charts.append(np.full(sol.y.shape[1], chart))
         if sol.status == 0:
             break
         t_event = sol.t_events
@@ -136,7 +156,7 @@ def _slack_event(p: np.ndarray, chart: int, wire: int):
 def _sampled_run(model, samples, grid, nfev, slack) -> KaneRun:
     parts = {k: [] for k in ("theta", "com", "rotation", "velocity", "omega", "tension", "energy", "chart")}
     for Y, chart in samples:
-        Y = np.ascontiguousarray(Y)
+        Y = np.ascontiguousarray(Y, dtype=float)
         com, frames, vel, omg, tension, _, energy = K.observe(Y, model.p, chart)
         theta = Y[:, :5].copy()
         if chart == TILT:
@@ -153,7 +173,7 @@ def _sampled_run(model, samples, grid, nfev, slack) -> KaneRun:
         parts["chart"].append(np.full(len(Y), chart))
     cat = {k: np.concatenate(v) for k, v in parts.items()}
     n = len(cat["energy"])
-    length_error = _length_errors(model, cat["com"], cat["rotation"])
+    length_error = length_errors(model.rig, cat["com"], cat["rotation"])
     return KaneRun(
         t=grid[:n],
         theta=cat["theta"],
@@ -169,12 +189,3 @@ def _sampled_run(model, samples, grid, nfev, slack) -> KaneRun:
         slack=slack,
     )
 
-
-def _length_errors(model: KaneModel, com: np.ndarray, rotation: np.ndarray) -> np.ndarray:
-    """|anchor - attachment| - length per sample and wire (m), from the pose alone."""
-    rig = model.rig
-    out = np.empty((len(com), len(rig.wires)))
-    for j, w in enumerate(rig.wires):
-        pts = com + rotation @ (w.attach - rig.com)
-        out[:, j] = np.linalg.norm(pts - w.anchor, axis=1) - w.length
-    return out

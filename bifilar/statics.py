@@ -44,9 +44,10 @@ class Rest:
 
 
 def attachments(rig: Rig, com: np.ndarray, rotation: np.ndarray) -> np.ndarray:
-    """World positions (n_wires x 3, m) of the attachment points for a pose."""
+    """World positions (..., n_wires, 3; m) of the attachment points for a pose, or for a stack of
+    poses (com ..., 3 and rotation ..., 3, 3)."""
     arms = np.array([w.attach - rig.com for w in rig.wires])
-    return com + arms @ rotation.T
+    return np.asarray(com)[..., None, :] + np.einsum("...ij,wj->...wi", rotation, arms)
 
 
 def anchors(rig: Rig) -> np.ndarray:
@@ -60,8 +61,8 @@ def lengths(rig: Rig) -> np.ndarray:
 
 
 def length_errors(rig: Rig, com: np.ndarray, rotation: np.ndarray) -> np.ndarray:
-    """Anchor-to-attachment distance minus wire length, per wire (m)."""
-    return np.linalg.norm(attachments(rig, com, rotation) - anchors(rig), axis=1) - lengths(rig)
+    """Anchor-to-attachment distance minus wire length, per wire (m), for a pose or a stack of poses."""
+    return np.linalg.norm(attachments(rig, com, rotation) - anchors(rig), axis=-1) - lengths(rig)
 
 
 def _equilibrium_residual(x: np.ndarray, rig: Rig, rotation0: np.ndarray, scale: float) -> np.ndarray:
@@ -126,7 +127,9 @@ def rest_pose(rig: Rig) -> Rest:
         gtol=1e-15,
     )
     residual = float(np.abs(sol.fun).max())
-    if residual > 1e-9:
+    # Dimensionless (forces / weight, lengths / rig size); 1e-16 on ordinary rigs, ~1e-9 where the
+    # Jacobian is singular (a COM on CD between vertical wires: two neutral directions).
+    if residual > 1e-7:
         raise RigError(rig.source, "wire", f"no equilibrium with every wire taut (residual {residual:.2e})")
     rotation = Rotation.from_rotvec(sol.x[3:6]).as_matrix() @ rotation0
     tensions = sol.x[6:] * rig.mass * rig.gravity
@@ -199,7 +202,10 @@ def initial_state(rig: Rig, rest: Rest | None = None) -> State:
     """The rig's initial state, exactly as the rig file's ``[initial]`` table defines it."""
     rest = rest_pose(rig) if rest is None else rest
     rotation = Rotation.from_rotvec(rig.initial_rotation).as_matrix() @ rest.rotation
-    com = rest.com + taut_shift(rig, rest.com, rotation)
+    try:
+        com = rest.com + taut_shift(rig, rest.com, rotation)
+    except RigError as exc:
+        raise RigError(rig.source, "initial.rotation", exc.problem) from None
     omega = np.asarray(rig.initial_omega, dtype=float)
     pts = attachments(rig, com, rotation)
     span = pts - anchors(rig)

@@ -133,3 +133,43 @@ def test_mujoco_output_step_must_be_whole_time_steps(tmp_path, capsys):
 def test_jobs_must_be_positive(capsys):
     code, _, err = run_cli(capsys, "all", "--jobs", "0")
     assert code == 2 and "--jobs must be at least 1" in err
+
+
+def test_a_wire_that_must_push_at_the_start_stops_the_kane_run(tmp_path, capsys):
+    """The thin plate tilted 0.9 rad about x: wire 2 would have to push from t = 0 (MuJoCo reads 0 N)."""
+    path = tmp_path / "push.toml"
+    path.write_text((RIGS / "sidesway.toml").read_text() + "\n[initial]\nrotation = [0.9, 0.0, 0.0]\n")
+    out = tmp_path / "push.csv"
+    code, _, err = run_cli(capsys, "simulate", str(path), "--duration", "1", "--out", str(out))
+    assert code == 3 and "wire[2]: went slack at t = 0 s" in err
+    assert len(out.read_text().splitlines()) == 2  # the header and the state at t = 0
+
+
+def test_the_last_sample_survives_rounding(tmp_path, capsys):
+    """3 x 0.1 > 0.3 in floating point: the sample at 0.3 s must still be written, by both engines."""
+    for engine in ("kane", "mujoco"):
+        out = tmp_path / f"{engine}.csv"
+        assert run_cli(capsys, "simulate", str(RIGS / "plate.toml"), "--engine", engine, "--duration", "0.3",
+                       "--dt-out", "0.1", "--out", str(out))[0] == 0
+        assert out.read_text().splitlines()[-1].startswith("0.3,")
+
+
+@pytest.mark.parametrize(
+    "content, field, words",
+    [
+        (b"\xff\xfe not text", "file", "not UTF-8"),
+        (GOOD.replace('name = "plate"', 'name = "../x y"').encode(), "name", "letters, digits"),
+        # Hooks exactly l + b' + l' apart: a flat loop, infinite tension.
+        (GOOD.replace("anchor = [0.0, 5.0,", "anchor = [0.0, 10.0,").encode(), "wire", "not shorter"),
+    ],
+)
+def test_more_bad_rig_files(tmp_path, capsys, content, field, words):
+    path = tmp_path / "bad.toml"
+    path.write_bytes(content)
+    code, _, err = run_cli(capsys, "modes", str(path))
+    assert code == 2 and err.startswith(f"error: {path}: {field}: ") and words in err and err.count("\n") == 1
+
+
+def test_unwritable_output_is_one_line(tmp_path, capsys):
+    code, _, err = run_cli(capsys, "simulate", str(RIGS / "plate.toml"), "--duration", "0.1", "--out", str(tmp_path))
+    assert code == 2 and err == f"error: {tmp_path}: cannot write (is a directory)\n"

@@ -67,6 +67,9 @@ def main(argv: list[str] | None = None) -> int:
     except (RigError, UsageError) as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
+    except OSError as exc:  # an output that cannot be written (inputs are read as RigError)
+        print(f"error: {exc.filename}: cannot write ({exc.strerror})", file=sys.stderr)
+        return 2
 
 
 def _cmd_modes(args) -> int:
@@ -100,18 +103,26 @@ def _cmd_modes(args) -> int:
 
 
 def _cmd_simulate(args) -> int:
+    from bifilar.simulate import IntegrationError, output_grid
+
     from .engines import EngineInputError, engines
-    from .trajectory import write_rig_csv
+    from .trajectory import NonFiniteTrajectory, write_rig_csv
 
     available = engines()
     if args.engine not in available:
         raise UsageError(f"--engine: unknown engine {args.engine!r} (choose from {', '.join(available)})")
+    try:
+        output_grid(args.duration, args.dt_out)
+    except ValueError as exc:
+        raise UsageError(f"--dt-out: {exc}") from None
     rig = load_rig(args.rig)
     try:
         traj = available[args.engine](rig, args.duration, args.dt_out, args.rtol)
+        write_rig_csv(traj, args.out)
     except EngineInputError as exc:
         raise UsageError(f"--dt-out: {exc}") from None
-    write_rig_csv(traj, args.out)
+    except (IntegrationError, NonFiniteTrajectory) as exc:
+        raise RigError(args.rig, "initial", f"the {args.engine} run failed ({exc}): the motion is too violent") from None
     if args.rerun:
         from .recording import record_trajectory
 

@@ -8,6 +8,7 @@ own, e.g. ``q`` and ``energy``. Every vector channel is in the world frame (z up
 from __future__ import annotations
 
 import csv
+import errno
 import os
 import tempfile
 from dataclasses import dataclass, field
@@ -55,6 +56,8 @@ def atomic_write_text(path: str | Path, text: str) -> None:
 def atomic_write_bytes(path: str | Path, data: bytes) -> None:
     """Write a whole file or nothing: write a temporary file beside it, then rename."""
     path = Path(path)
+    if path.is_dir():
+        raise IsADirectoryError(errno.EISDIR, "is a directory", str(path))
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", dir=path.parent)
     try:
@@ -65,6 +68,10 @@ def atomic_write_bytes(path: str | Path, data: bytes) -> None:
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
         raise
+
+
+class NonFiniteTrajectory(ValueError):
+    """A trajectory with NaN or infinite samples: never written."""
 
 
 def _umask() -> int:
@@ -78,7 +85,7 @@ def write_rig_csv(traj: Trajectory, path: str | Path) -> None:
     columns = [traj.t[:, None]] + [np.asarray(traj[name]).reshape(len(traj.t), -1) for name in RIG_CHANNELS]
     table = np.hstack(columns)
     if not np.all(np.isfinite(table)):
-        raise ValueError(f"{path}: trajectory has non-finite values; nothing written")
+        raise NonFiniteTrajectory(f"{path}: trajectory has non-finite values; nothing written")
     lines = [",".join(RIG_CSV_HEADER)]
     lines += [",".join(repr(float(x)) for x in row) for row in table]
     atomic_write_text(path, "\n".join(lines) + "\n")

@@ -21,6 +21,7 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from bifilar.rig import Rig
+from bifilar.simulate import IntegrationError, output_grid
 from bifilar.statics import State, initial_state
 
 from ..trajectory import Trajectory
@@ -60,7 +61,8 @@ def simulate(model: mujoco.MjModel, rig: Rig, state: State, duration: float, dt_
     nstep = round(dt_out / model.opt.timestep)
     if nstep < 1 or abs(nstep * model.opt.timestep - dt_out) > 1e-9 * dt_out:
         raise EngineInputError(f"dt_out = {dt_out:g} s is not a whole number of time steps ({model.opt.timestep:g} s)")
-    n_out = int(np.floor(duration / dt_out + 1e-9)) + 1
+    times = output_grid(duration, dt_out)
+    n_out = len(times)
     data = mujoco.MjData(model)
     data.qpos[:], data.qvel[:] = mjcf.state_qpos_qvel(rig, state)
     half = 0.5 * model.opt.timestep if staggered and model.opt.integrator != mujoco.mjtIntegrator.mjINT_RK4 else 0.0
@@ -96,7 +98,7 @@ def simulate(model: mujoco.MjModel, rig: Rig, state: State, duration: float, dt_
         "first_slack": None if not slack.size else (int(slack[0, 1]) + 1, float(slack[0, 0] * dt_out)),
     }
     engine = "mujoco" if cables == "tendon" else "mujoco-eq"
-    return Trajectory(engine, np.arange(n_out) * dt_out, channels, meta)
+    return Trajectory(engine, times, channels, meta)
 
 
 def _cable_rows(model: mujoco.MjModel, cables: str) -> tuple[int, int]:
@@ -144,7 +146,7 @@ def _check_warnings(data: mujoco.MjData, t: float) -> None:
     for i in range(mujoco.mjtWarning.mjNWARNING):
         if data.warning[i].number:
             name = mujoco.mjtWarning(i).name
-            raise RuntimeError(f"mujoco: {name} by t = {t:g} s; the run is not valid (numerics too coarse?)")
+            raise IntegrationError(f"mujoco: {name} by t = {t:g} s; the run is not valid (numerics too coarse?)")
 
 
 ENGINES = {
