@@ -1,4 +1,4 @@
-"""argparse value types with one-line messages that name the option (the CLI prints them, exit 2)."""
+"""argparse pieces whose errors are one line naming the option (the CLI prints them, exit 2)."""
 
 from __future__ import annotations
 
@@ -34,3 +34,14 @@ def whole_number(name: str, minimum: int):
         return value
 
     return parse
+
+
+class UsageError(Exception):
+    """Bad command-line input; printed as one line, exit status 2."""
+
+
+class OneLineParser(argparse.ArgumentParser):
+    """Reports a usage error as one line (:class:`UsageError`) instead of usage text and exit."""
+
+    def error(self, message):  # one line instead of usage + message
+        raise UsageError(f"{self.prog}: {message}")

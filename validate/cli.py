@@ -13,21 +13,12 @@ import sys
 from bifilar.rig import RigError, load_rig
 
 from . import boat_cli, identify_cli
-from .argtypes import positive_float, whole_number
-
-
-class UsageError(Exception):
-    """Bad command-line input; printed as one line, exit status 2."""
-
-
-class _Parser(argparse.ArgumentParser):
-    def error(self, message):  # one line instead of usage + message
-        raise UsageError(f"{self.prog}: {message}")
+from .argtypes import OneLineParser, UsageError, positive_float, whole_number
 
 
 def build_parser() -> argparse.ArgumentParser:
-    parser = _Parser(prog="python -m validate", description=__doc__.splitlines()[0])
-    sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
+    parser = OneLineParser(prog="python -m validate", description=__doc__.splitlines()[0])
+    sub = parser.add_subparsers(dest="command", required=True, parser_class=OneLineParser)
 
     p = sub.add_parser("all", help="run every registered validation case")
     p.add_argument("--json", metavar="REPORT.json", help="also write the report as JSON")

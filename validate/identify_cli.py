@@ -43,7 +43,7 @@ def add_parser(subparsers) -> None:
     p.add_argument("--amplitude", type=positive_float("--amplitude"), help="peak rotation while timed, rad")
     p.add_argument("--column", help="signal column (default: the --kind)")
     p.add_argument("--kind", choices=("angle", "rate"), default="angle", help="what the signal column holds")
-    p.add_argument("--samples", type=whole_number("--samples", 2), help="Monte Carlo draws instead of linear propagation")
+    p.add_argument("--samples", type=whole_number("--samples", 100), help="Monte Carlo draws instead of linear propagation")
     p.add_argument("--json", action="store_true", help="print one JSON object")
 
 
@@ -52,7 +52,7 @@ def run(args) -> int:
     from bifilar.identify import identify
     from bifilar.propagation import linear, monte_carlo
 
-    from .cli import UsageError
+    from .argtypes import UsageError
 
     if args.signal is not None and args.amplitude is not None:
         raise UsageError("identify: --amplitude goes with --period; a --signal's amplitude is fitted")

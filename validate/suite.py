@@ -37,7 +37,7 @@ def registered(slow: bool = False) -> list[Case]:
 
 
 def find(name: str) -> Case:
-    from .cli import UsageError
+    from .argtypes import UsageError
 
     cases = {c.name: c for c in registered(slow=True)}
     if name not in cases:

@@ -25,7 +25,6 @@ Building is stateless and costs about a millisecond, so sweeps may build thousan
 
 from __future__ import annotations
 
-import argparse
 import sys
 from dataclasses import dataclass, replace
 from pathlib import Path
@@ -318,14 +317,19 @@ def main(argv: list[str] | None = None) -> int:
 def xml_main(argv, description: str, input_help: str, write) -> int:
     """A command line ``INPUT DIR`` that calls ``write(INPUT, DIR)`` and prints the files written; a
     bad input is one line on stderr and exit status 2."""
-    parser = argparse.ArgumentParser(description=description)
+    from ..argtypes import OneLineParser, UsageError
+
+    parser = OneLineParser(description=description)
     parser.add_argument("input", help=input_help)
     parser.add_argument("directory", help="output folder")
-    args = parser.parse_args(argv)
     try:
+        args = parser.parse_args(argv)
         paths = write(args.input, args.directory)
-    except RigError as exc:
+    except (RigError, UsageError) as exc:
         print(f"error: {exc}", file=sys.stderr)
+        return 2
+    except OSError as exc:
+        print(f"error: {exc.filename}: cannot write ({exc.strerror})", file=sys.stderr)
         return 2
     for path in paths:
         print(path)
