@@ -261,3 +261,17 @@ def test_nice_ticks():
     """The smallest step of 1, 2 or 5 times a power of ten that is at least a fifth of the range."""
     np.testing.assert_allclose(nice_ticks(768.7, 1020.0), [700, 800, 900, 1000, 1100])  # 50.3 -> 100
     np.testing.assert_allclose(nice_ticks(0.0, 10.0), [0, 2, 4, 6, 8, 10])
+
+
+def test_a_hall_too_low_recommends_nothing(study):
+    """Every configuration hangs ~5.4-5.6 m below the hooks: with the floor 5.5 m down, configurations
+    1 and 2 reach it and only 3 may be recommended; with it 1 m down, none."""
+    from dataclasses import replace
+
+    from validate.boat_study import recommend
+
+    low = replace(study, suspension=replace(study.suspension, hook_height=5.5))
+    choice = recommend(low)
+    assert choice["configuration"] == "3"
+    assert sum("is excluded" in r for r in choice["reasons"]) == 2
+    assert recommend(replace(study, suspension=replace(study.suspension, hook_height=1.0)))["configuration"] is None

@@ -229,10 +229,21 @@ def recommend(study: Study) -> dict:
                        f"{100 * rel[:, k].max():.2g} % in configuration {names[int(np.argmax(rel[:, k]))]} "
                        f"(d ln T / d ln I = {m.found.sensitivity:.2g}, largest error source: {top}, "
                        f"{100 * m.spread.budget[top]:.0f} % of the variance)")
-    overall = int(np.argmin(rel.max(axis=1)))
-    choice["configuration"] = names[overall]
-    reasons.insert(0, f"configuration {names[overall]} has the smallest worst-case sigma of the three moments, "
-                      f"{100 * rel[overall].max():.2g} %")
+    # A configuration whose swinging boat reaches the floor is out, whatever its accuracy.
+    margin = np.array([study.suspension.hook_height - c.depth for c in confs])
+    if np.all(margin < 0.0):
+        choice["configuration"] = None
+        reasons.insert(0, f"no configuration clears the floor: the boat reaches {-margin.max():.3g} m below it at "
+                          f"best; hang the hooks higher or the wires shorter")
+    else:
+        worst = np.where(margin >= 0.0, rel.max(axis=1), np.inf)
+        overall = int(np.argmin(worst))
+        choice["configuration"] = names[overall]
+        reasons.insert(0, f"configuration {names[overall]} has the smallest worst-case sigma of the three moments "
+                          f"among those that clear the floor, {100 * rel[overall].max():.2g} %")
+        for c, m in zip(names, margin):
+            if m < 0.0:
+                reasons.append(f"configuration {c} is excluded: the boat reaches {-m:.3g} m below the floor")
     for label, values in (("peak wire tension", [c.tension_max.max() for c in confs]),
                           ("peak in-plane pull on the deck", [c.in_plane_max.max() for c in confs])):
         low, high = int(np.argmin(values)), int(np.argmax(values))
