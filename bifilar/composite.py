@@ -218,3 +218,14 @@ def part_from_dict(table: dict, source: str = "<memory>", prefix: str = "part.")
         rotvec = vector3(table.get("rotation", [0.0, 0.0, 0.0]), source, prefix + "rotation")
         rotation = Rotation.from_rotvec(rotvec).as_matrix()
     return Part(name=name, shape=shape_name, dims=dims, mass=mass, position=position, rotation=rotation)
+
+
+def equivalent_box(mass: float, inertia: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Half sizes (m) and orientation (rotation matrix, columns = box axes in the body frame) of the
+    uniform box with this mass and inertia tensor (about the COM): along principal axis i,
+    edge_i^2 = 6 (I_j + I_k - I_i) / m. Used to draw a body whose shape is not known."""
+    moments, axes = np.linalg.eigh(inertia)
+    if np.linalg.det(axes) < 0.0:
+        axes[:, 2] *= -1.0  # a rotation, not a reflection
+    edges = np.sqrt(np.maximum(6.0 * (moments.sum() - 2.0 * moments) / mass, 0.0))
+    return 0.5 * edges, axes

@@ -30,6 +30,8 @@ import rerun as rr
 import rerun.blueprint as rrb
 from scipy.spatial.transform import Rotation
 
+from bifilar.composite import equivalent_box
+
 from .registry import Metric
 from .trajectory import RIG_CHANNELS, Trajectory
 
@@ -152,13 +154,9 @@ def tension_colors(tension: np.ndarray, t_max: float) -> np.ndarray:
 
 
 def inertia_box(inertia: np.ndarray, mass: float) -> tuple[np.ndarray, np.ndarray]:
-    """Half sizes and orientation (xyzw quaternion, body frame) of the uniform box with the body's
-    mass and inertia: along principal axis i, a_i^2 = 6 (I_j + I_k - I_i) / m."""
-    moments, axes = np.linalg.eigh(inertia)
-    if np.linalg.det(axes) < 0.0:
-        axes[:, 2] *= -1.0  # a rotation, not a reflection
-    full = np.sqrt(np.maximum(6.0 * (moments.sum() - 2.0 * moments) / mass, 0.0))
-    return 0.5 * full, Rotation.from_matrix(axes).as_quat()
+    """:func:`bifilar.composite.equivalent_box` as half sizes and an xyzw quaternion (rerun's order)."""
+    half, axes = equivalent_box(mass, inertia)
+    return half, Rotation.from_matrix(axes).as_quat()
 
 
 def _log_scene(rec: rr.RecordingStream, runs: list[_Run]) -> None:

@@ -33,6 +33,7 @@ import mujoco
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from bifilar.composite import equivalent_box
 from bifilar.rig import Rig, RigError, load_rig
 from bifilar.statics import Rest, State, attachments, initial_state, rest_pose
 
@@ -276,15 +277,10 @@ def _add_defaults(spec: mujoco.MjSpec, rig: Rig, cables: str, numerics: Numerics
 
 
 def _inertia_box(rig: Rig) -> tuple[np.ndarray, np.ndarray]:
-    """Half sizes (m) and body-frame quaternion of the uniform box with the rig's mass and inertia:
-    a box of edges e has I_x = m (e_y^2 + e_z^2) / 12 about its principal axes."""
-    moments, axes = np.linalg.eigh(rig.inertia)
-    if np.linalg.det(axes) < 0.0:
-        axes[:, 0] = -axes[:, 0]
-    edges2 = 6.0 * (moments.sum() - 2.0 * moments) / rig.mass
-    edges = np.sqrt(np.clip(edges2, 0.0, None))
-    edges = np.maximum(edges, _MIN_BOX * edges.max())
-    return 0.5 * edges, Rotation.from_matrix(axes).as_quat(scalar_first=True)
+    """:func:`bifilar.composite.equivalent_box` as half sizes, no edge thinner than ``_MIN_BOX`` of the
+    longest (a flat body stays visible), and a wxyz quaternion (MuJoCo's order)."""
+    half, axes = equivalent_box(rig.mass, rig.inertia)
+    return np.maximum(half, _MIN_BOX * half.max()), Rotation.from_matrix(axes).as_quat(scalar_first=True)
 
 
 def _header(rig: Rig, cables: str, numerics: Numerics) -> str:
