@@ -132,3 +132,17 @@ def test_printed_appendix_matches_except_the_listed_typos(plate_model):
     assert [tuple(i) for i in np.argwhere(dVdot)] == [(0, 1)]  # vdot12
     assert list(np.flatnonzero(dbeta)) == [4]  # beta5
     assert printed_beta(th, m.b, m.b_prime, m.l)[4] == pytest.approx(-beta[4], rel=1e-12)
+
+
+def test_theta5_completion_closes_the_loop_and_keeps_it_closed(plate_model):
+    """(5.1.2) and (5.1.4): theta5 from g(theta) = a, and theta5' = gamma . theta'_{1..4} keeps dg/dt = 0."""
+    rng = np.random.default_rng(6)
+    base = np.array([0.0, np.pi / 6, np.pi / 2, 0.0])
+    for _ in range(10):
+        th14 = base + 0.1 * rng.standard_normal(4)
+        dth14 = rng.standard_normal(4)
+        th5, dth5 = plate_model.complete_theta5(th14, dth14, 0.0)
+        theta, dtheta = np.append(th14, th5), np.append(dth14, dth5)
+        assert abs(plate_model.constraint(theta)) < 1e-12  # m^2, Newton to rounding
+        g_rate = fd(lambda t: np.array([plate_model.constraint(t)]), theta, dtheta)[0]
+        assert abs(g_rate) < 1e-7  # finite difference of a quantity that is zero to first order

@@ -95,7 +95,7 @@ def record(path: str | Path, title: str, trajectories: Sequence[Trajectory], met
 
 
 def record_case(result: CaseResult, path: str | Path) -> Path:
-    """Record a :class:`~validate.suite.CaseResult` (run with ``keep_trajectories=True``)."""
+    """Record a :class:`~validate.suite.CaseResult` (run with its trajectories kept)."""
     note = result.error or ""
     return record(path, f"{result.name} ({result.source})", result.trajectories, result.metrics, result.passed, note)
 

@@ -60,13 +60,13 @@ def run_case(name: str, keep_trajectories: bool = False) -> CaseResult:
     return CaseResult(c.name, c.source, passed, seconds, metrics, error, ctx.trajectories if keep_trajectories else [])
 
 
-def run_cases(cases: list[Case], jobs: int = 2, json_path: str | None = None, keep_trajectories: bool = False,
+def run_cases(cases: list[Case], jobs: int = 2, json_path: str | None = None,
               on_result: Callable[[CaseResult], object] | None = None) -> int:
     """Run the cases, print the table (and write the JSON report); 0 if all passed, else 1.
-    ``on_result`` is called on every result in this process (e.g. to record it): it implies
-    ``keep_trajectories``."""
+    ``on_result`` is called on every result in this process (e.g. to record it); only then are the
+    trajectories carried back from the workers."""
     names = [c.name for c in cases]
-    keep = keep_trajectories or on_result is not None
+    keep = on_result is not None
     if jobs > 1 and len(names) > 1:
         with ProcessPoolExecutor(max_workers=jobs) as pool:
             results = list(pool.map(run_case, names, [keep] * len(names)))

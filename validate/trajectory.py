@@ -16,6 +16,7 @@ from pathlib import Path
 from typing import Any, Mapping
 
 import numpy as np
+from scipy.spatial.transform import Rotation
 
 # name -> (columns in the CSV, meaning)
 RIG_CHANNELS = {
@@ -46,6 +47,13 @@ class Trajectory:
         """The samples with t <= t_end."""
         keep = self.t <= t_end + 1e-12
         return Trajectory(self.engine, self.t[keep], {k: v[keep] for k, v in self.channels.items()}, self.meta)
+
+
+def rig_quaternions(rotation: Rotation) -> np.ndarray:
+    """The ``quat`` channel: unit quaternions (n, 4), scalar first, in one hemisphere (qw >= 0) so
+    that engines that agree give equal numbers."""
+    quat = rotation.as_quat(scalar_first=True)
+    return quat * np.where(quat[:, :1] < 0.0, -1.0, 1.0)
 
 
 def atomic_write_text(path: str | Path, text: str) -> None:

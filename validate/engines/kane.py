@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import numpy as np
 from scipy.spatial.transform import Rotation
 
 from bifilar.kane import KaneModel
@@ -10,7 +9,7 @@ from bifilar.rig import Rig
 from bifilar.simulate import KaneRun, simulate
 from bifilar.statics import State, initial_state
 
-from ..trajectory import Trajectory
+from ..trajectory import Trajectory, rig_quaternions
 
 
 def run(rig: Rig, duration: float, dt_out: float = 0.01, rtol: float = 1e-10, state: State | None = None) -> Trajectory:
@@ -21,8 +20,7 @@ def run(rig: Rig, duration: float, dt_out: float = 0.01, rtol: float = 1e-10, st
 
 
 def to_trajectory(kr: KaneRun, rig: Rig, rtol: float) -> Trajectory:
-    quat = Rotation.from_matrix(kr.rotation).as_quat(scalar_first=True)
-    quat *= np.where(quat[:, :1] < 0.0, -1.0, 1.0)  # one hemisphere: qw >= 0
+    quat = rig_quaternions(Rotation.from_matrix(kr.rotation))
     channels = {
         "com": kr.com,
         "quat": quat,

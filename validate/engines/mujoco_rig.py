@@ -24,7 +24,7 @@ from bifilar.rig import Rig
 from bifilar.simulate import IntegrationError, output_grid
 from bifilar.statics import State, initial_state
 
-from ..trajectory import Trajectory
+from ..trajectory import Trajectory, rig_quaternions
 from . import EngineInputError, mjcf
 from .mjcf import CHOSEN, Numerics
 
@@ -135,8 +135,7 @@ def rig_channels(rig: Rig, qpos: np.ndarray, qvel: np.ndarray) -> dict[str, np.n
     com = qpos[:, :3] + arm
     omega = rot.apply(qvel[:, 3:6])
     velocity = qvel[:, :3] + np.cross(omega, arm)
-    quat = qpos[:, 3:7] / np.linalg.norm(qpos[:, 3:7], axis=1, keepdims=True)
-    quat *= np.where(quat[:, :1] < 0.0, -1.0, 1.0)
+    quat = rig_quaternions(rot)
     spin = np.einsum("ij,ij->i", qvel[:, 3:6], qvel[:, 3:6] @ rig.inertia)  # w.Iw in body axes
     energy = 0.5 * rig.mass * np.einsum("ij,ij->i", velocity, velocity) + 0.5 * spin + rig.mass * rig.gravity * com[:, 2]
     return {"com": com, "quat": quat, "velocity": velocity, "omega": omega, "energy": energy}
