@@ -76,7 +76,7 @@ def static_tension(ctx: CaseContext):
               "equilibrium solved to machine precision"),
         check("printed 566.38 N", max_abs(kane - 566.38), 5e-3, "the thesis prints two decimals", unit="N"),
         check("tension change over 10 s at rest", max_abs(run.tension - expected) / expected, 1e-9,
-              "rest is an equilibrium: only integration error moves it"),
+              "the rest pose of the statics (KKT) must be an equilibrium of the Kane equations"),
     ]
 
 
