@@ -12,10 +12,10 @@ import pytest
 
 from bifilar.seed001 import integrate, seed
 from bifilar.seed001.chain import Chain
-from bifilar.seed001.mjcf import build_model
-from bifilar.seed001.mujoco_run import Prober, simulate
 from bifilar.seed001.params import Params, load_params
 from validate.assets import MODELS
+from validate.engines.seed001_mjcf import build_model
+from validate.engines.seed001_mujoco import Prober, simulate
 
 DIR = MODELS / "seed001"
 EPS = float(np.finfo(float).eps)

@@ -6,7 +6,8 @@ import numpy as np
 import pytest
 
 from bifilar import seed002, tmt
-from bifilar import tmt_mujoco as tm
+from validate.engines import seed002_mujoco
+from validate.engines import tmt_mujoco as tm
 
 
 @pytest.fixture(scope="module")
@@ -21,7 +22,7 @@ def chain(params):
 
 @pytest.fixture(scope="module")
 def model(params):
-    return seed002.model(params)
+    return seed002_mujoco.model(params)
 
 
 def random_states(n, seed):
@@ -40,7 +41,7 @@ def test_mass_matrix_and_bias_match_mujoco(chain, model):
 
 
 def test_body_loads_match_cfrc_int(chain, model):
-    """The seed's per-body net forces and moments against MuJoCo's cfrc_int (see bifilar.tmt_mujoco);
+    """The seed's per-body net forces and moments against MuJoCo's cfrc_int (see validate.engines.tmt_mujoco);
     each engine uses its own accelerations (a 2x2 solve, condition number up to 115)."""
     data = mujoco.MjData(model)
     for q, qd in random_states(50, 1):

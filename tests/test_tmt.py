@@ -1,5 +1,5 @@
 """The TMT implementation (bifilar.tmt) on textbook systems with closed forms, its kinematics
-against finite differences, and a skewed spatial chain against MuJoCo (bifilar.tmt_mujoco)."""
+against finite differences, and a skewed spatial chain against MuJoCo (validate.engines.tmt_mujoco)."""
 
 import mujoco
 import numpy as np
@@ -8,8 +8,8 @@ from scipy.spatial.transform import Rotation
 from scipy.special import ellipk
 
 from bifilar import tmt
-from bifilar import tmt_mujoco as tm
 from bifilar.tmt import Body, Chain, Frame
+from validate.engines import tmt_mujoco as tm
 from validate.metrics import period
 
 G = 9.81

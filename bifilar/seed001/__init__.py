@@ -6,6 +6,7 @@ Rayleigh friction, in a vertical plane.
   and :func:`.seed.g_fixed`, the repair of the one formula that fails;
 * :mod:`.chain` -- the same pendulum derived independently, as a planar two-link chain;
 * :mod:`.integrate` -- the seed's RK4 and scipy's DOP853;
-* :mod:`.mjcf`, :mod:`.mujoco_run` -- the MuJoCo model built from the parameters, and its runs with
-  the seed's friction applied as generalized forces.
+The MuJoCo side (the model built from the parameters, and its runs with the seed's friction applied
+as generalized forces) is :mod:`validate.engines.seed001_mjcf` and :mod:`validate.engines.seed001_mujoco`:
+this package holds only the hand-derived equations.
 """

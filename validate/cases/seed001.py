@@ -18,9 +18,9 @@ import numpy as np
 from scipy.integrate import cumulative_simpson
 
 from bifilar.seed001 import integrate, seed
-from bifilar.seed001.mjcf import build_model
-from bifilar.seed001.mujoco_run import MujocoRun, Prober, simulate
 from bifilar.seed001.params import Params, load_params
+from validate.engines.seed001_mjcf import build_model
+from validate.engines.seed001_mujoco import MujocoRun, Prober, simulate
 
 from ..assets import MODELS
 from ..metrics import channel_difference, energy_drift, max_abs

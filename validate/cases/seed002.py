@@ -1,7 +1,7 @@
 """Seed 002: the TMT three-body pendulum (:mod:`bifilar.seed002`) against MuJoCo.
 
 Both engines read ``models/seed002/params.toml``. The TMT engine integrates ``M* q'' = F* - N* q'``
-with DOP853; MuJoCo steps the same chain (:mod:`bifilar.tmt_mujoco`) with RK4. q = (theta, phi),
+with DOP853; MuJoCo steps the same chain (:mod:`validate.engines.tmt_mujoco`) with RK4. q = (theta, phi),
 rad; energy in J with zero potential at the inertial origin.
 """
 
@@ -13,7 +13,8 @@ import mujoco
 import numpy as np
 
 from bifilar import seed002, tmt
-from bifilar import tmt_mujoco as tm
+from validate.engines import seed002_mujoco
+from validate.engines import tmt_mujoco as tm
 
 from ..metrics import channel_difference, energy_drift, max_abs
 from ..registry import CaseContext, case, check
@@ -39,7 +40,7 @@ def _random_states(rng: np.random.Generator, n: int) -> list[tuple[np.ndarray, n
 def mass_bias(ctx: CaseContext):
     """M* = B^T M B against mj_fullM, and N* q' - F* against qfrc_bias, at random states."""
     p = seed002.load()
-    chain, model = seed002.chain(p), seed002.model(p)
+    chain, model = seed002.chain(p), seed002_mujoco.model(p)
     data = mujoco.MjData(model)
     dM, dh, scale_M, scale_h = 0.0, 0.0, 0.0, 0.0
     for q, qd in _random_states(np.random.default_rng(2), N_STATES):
@@ -59,9 +60,9 @@ def mass_bias(ctx: CaseContext):
 def body_loads(ctx: CaseContext):
     """The seed's last section: per-body net force m^i x''^i (inertial frame) and net moment about the
     COM J^i w'^i + w^i x J^i w^i (body axes), each engine at its own accelerations, against MuJoCo's
-    cfrc_int after mj_rnePostConstraint (see bifilar.tmt_mujoco for the frames and reference points)."""
+    cfrc_int after mj_rnePostConstraint (see validate.engines.tmt_mujoco for the frames and reference points)."""
     p = seed002.load()
-    chain, model = seed002.chain(p), seed002.model(p)
+    chain, model = seed002.chain(p), seed002_mujoco.model(p)
     data = mujoco.MjData(model)
     dF, dT, scale_F, scale_T = 0.0, 0.0, 0.0, 0.0
     for q, qd in _random_states(np.random.default_rng(3), N_STATES):
@@ -152,7 +153,7 @@ def _tmt_traj(run: tmt.Solution) -> Trajectory:
 def _mujoco_traj(timestep: float, duration: float) -> Trajectory:
     """A MuJoCo release run with RK4 at the given timestep (s)."""
     p = seed002.load()
-    model = seed002.model(p)
+    model = seed002_mujoco.model(p)
     model.opt.timestep = timestep
     run = tm.simulate(model, p.q0, p.qd0, duration, DT_OUT)
     return Trajectory("mujoco", run.t, {"q": run.q, "energy": run.energy},

@@ -13,7 +13,7 @@ from pathlib import Path
 import mujoco
 import numpy as np
 
-from .params import Params
+from bifilar.seed001.params import Params
 
 PLATE_THICKNESS = 0.004  # m, drawing only
 
