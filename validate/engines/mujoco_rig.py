@@ -14,6 +14,7 @@ pass. How velocities are started and read is explained in :func:`simulate`.
 
 from __future__ import annotations
 
+from contextlib import contextmanager
 from functools import partial
 
 import mujoco
@@ -71,19 +72,20 @@ def simulate(model: mujoco.MjModel, rig: Rig, state: State, duration: float, dt_
     qvel = np.empty((n_out, model.nv))
     tension = np.empty((n_out, len(rig.wires)))
     length = np.empty((n_out, len(rig.wires)))
-    for k in range(n_out):
-        if k:
-            mujoco.mj_step(model, data, nstep)
-        mujoco.mj_forward(model, data)
-        _check_warnings(data, k * dt_out)
-        qpos[k] = data.qpos
-        tension[k] = cable_tensions(data, rows)
-        length[k] = data.ten_length
-        if k:
-            qvel[k] = data.qvel + half * data.qacc
-        else:
-            qvel[k] = data.qvel
-            data.qvel -= half * data.qacc
+    with _quiet_warnings():  # reported by _check_warnings as one error, not printed by MuJoCo
+        for k in range(n_out):
+            if k:
+                mujoco.mj_step(model, data, nstep)
+            mujoco.mj_forward(model, data)
+            _check_warnings(data, k * dt_out)
+            qpos[k] = data.qpos
+            tension[k] = cable_tensions(data, rows)
+            length[k] = data.ten_length
+            if k:
+                qvel[k] = data.qvel + half * data.qacc
+            else:
+                qvel[k] = data.qvel
+                data.qvel -= half * data.qacc
     channels = rig_channels(rig, qpos, qvel)
     channels["tension"] = tension
     channels["length_error"] = length - np.array([w.length for w in rig.wires])
@@ -139,6 +141,18 @@ def rig_channels(rig: Rig, qpos: np.ndarray, qvel: np.ndarray) -> dict[str, np.n
     spin = np.einsum("ij,ij->i", qvel[:, 3:6], qvel[:, 3:6] @ rig.inertia)  # w.Iw in body axes
     energy = 0.5 * rig.mass * np.einsum("ij,ij->i", velocity, velocity) + 0.5 * spin + rig.mass * rig.gravity * com[:, 2]
     return {"com": com, "quat": quat, "velocity": velocity, "omega": omega, "energy": energy}
+
+
+@contextmanager
+def _quiet_warnings():
+    """Silence MuJoCo's own warning printer (and its MUJOCO_LOG.TXT) for the run, restoring the previous
+    handler after: the run still fails on any warning, through :func:`_check_warnings`."""
+    previous = mujoco.get_mju_user_warning()
+    mujoco.set_mju_user_warning(lambda message: None)
+    try:
+        yield
+    finally:
+        mujoco.set_mju_user_warning(previous)
 
 
 def _check_warnings(data: mujoco.MjData, t: float) -> None:
