@@ -124,16 +124,21 @@ def torsion(ctx: CaseContext):
     """Torsion with parallel wires (0.1 rad) and splayed wires (10 degrees): periods and agreement."""
     out = []
     for name in ("parallel", "plate"):
-        r = rig(name)
-        runs = run_all(r, 20.0, 0.01)
-        ctx.keep(*runs.values())
-        kane_period = period(runs["kane"].t, _yaw(runs["kane"])).value
-        for engine in MUJOCO:
-            measured = period(runs[engine].t, _yaw(runs[engine])).value
-            out.append(check(f"{name}: {engine} torsion period vs kane", abs(measured / kane_period - 1.0),
-                             AGREEMENT[engine].period, AGREEMENT[engine].reason))
-        out += [replace(m, name=f"{name}: {m.name}") for m in agreement_metrics(runs, rest_pose(r).tensions.mean())]
+        out += torsion_agreement(ctx, rig(name), 20.0)
     return out
+
+
+def torsion_agreement(ctx: CaseContext, r, duration: float) -> list[Metric]:
+    """The rig's [initial] torsion on every engine: MuJoCo's torsion period and agreement vs Kane."""
+    runs = run_all(r, duration, 0.01)
+    ctx.keep(*runs.values())
+    kane_period = period(runs["kane"].t, _yaw(runs["kane"])).value
+    out = []
+    for engine in MUJOCO:
+        measured = period(runs[engine].t, _yaw(runs[engine])).value
+        out.append(check(f"{r.name}: {engine} torsion period vs kane over {duration:g} s",
+                         abs(measured / kane_period - 1.0), AGREEMENT[engine].period, AGREEMENT[engine].reason))
+    return out + [replace(m, name=f"{r.name}: {m.name}") for m in agreement_metrics(runs, rest_pose(r).tensions.mean())]
 
 
 def _yaw(traj: Trajectory) -> np.ndarray:
@@ -299,17 +304,8 @@ def slack(ctx: CaseContext):
 def long_run(ctx: CaseContext):
     """Two minutes of the plate's torsion and of the asymmetric rig's tumble: drifts that a 20 s case
     cannot see (energy, wire length, phase)."""
-    out = []
-    plate = rig("plate")
-    runs = run_all(plate, 120.0, 0.01)
-    ctx.keep(*runs.values())
-    kane_period = period(runs["kane"].t, _yaw(runs["kane"])).value
-    for name in MUJOCO:
-        measured = period(runs[name].t, _yaw(runs[name])).value
-        out.append(check(f"plate: {name} torsion period vs kane over 120 s", abs(measured / kane_period - 1.0),
-                         AGREEMENT[name].period, AGREEMENT[name].reason))
     # Phase error grows linearly: 3e-10 of a 1.95 s period over 60 periods moves the COM ~1e-8 m.
-    out += [replace(m, name=f"plate: {m.name}") for m in agreement_metrics(runs, rest_pose(plate).tensions.mean())]
+    out = torsion_agreement(ctx, rig("plate"), 120.0)
     asym = rig("asymmetric")
     for name, traj in run_all(asym, 120.0, 0.01).items():
         scale = asym.mass * asym.gravity * max(w.length for w in asym.wires)
