@@ -14,6 +14,12 @@ from bifilar.periods import Period, crossing_times, period  # noqa: F401  (metri
 from .trajectory import Trajectory
 
 
+def yaw(traj: Trajectory) -> np.ndarray:
+    """Torsion angle (rad): the vertical (world z) component of the body's rotation vector, which for
+    a twist about the vertical is the twist itself."""
+    return Rotation.from_quat(traj["quat"], scalar_first=True).as_rotvec()[:, 2]
+
+
 def max_abs(x) -> float:
     """Largest absolute value of an array (NaN propagates)."""
     x = np.asarray(x, dtype=float)

@@ -8,13 +8,11 @@ exactly the amount their quadratures predict: that is the "expected size of the 
 
 from __future__ import annotations
 
-from scipy.spatial.transform import Rotation
-
 from bifilar import lagrange as L
 
 from ..assets import rig
 from ..engines.kane import run as kane_run
-from ..metrics import period
+from ..metrics import period, yaw
 from ..registry import CaseContext, case, check
 
 AMPLITUDES = (0.05, 0.1745, 0.5)  # rad: small, the 10 degrees of the rig files, large
@@ -31,21 +29,21 @@ def torsion_models(ctx: CaseContext):
         for a in AMPLITUDES:
             exact = L.period(tr, a, vertical_ke=True)
             dropped = L.period(tr, a, vertical_ke=False)
-            traj = kane_run(r.with_initial(rotation=(0.0, 0.0, a)), 12.0 * exact, exact / 100.0)
+            traj = _torsion(r, a, exact, cycles=12)
             ctx.keep(traj)
-            yaw = Rotation.from_quat(traj["quat"], scalar_first=True).as_rotvec()[:, 2]
-            kane = period(traj.t, yaw, level=0.0).value
+            kane = period(traj.t, yaw(traj), level=0.0).value
             label = "(5.2.13)" if name == "parallel" else "6.2 adjusted"
             # Kane = exact 1-DOF model, so the printed model's period is short by exactly exact/dropped - 1.
             out.append(check(f"{name} {a} rad: kane vs exact 1-DOF; {label} short by {kane / dropped - 1:.3e}",
                              abs(kane / exact - 1.0), TOL, "same motion, two formulations"))
         small = L.linear_period(tr)
-        kane_small = period(*_torsion(r, 1e-4, small)).value
+        twist = _torsion(r, 1e-4, small, cycles=10)
+        kane_small = period(twist.t, yaw(twist)).value
         out.append(check(f"{name}: (5.2.17) generalised vs kane at 1e-4 rad", abs(kane_small / small - 1.0), 2e-8,
                          "amplitude effect ~1e-8 at 1e-4 rad plus TOL"))
     return out
 
 
-def _torsion(r, amplitude: float, period_guess: float):
-    traj = kane_run(r.with_initial(rotation=(0.0, 0.0, amplitude)), 10.0 * period_guess, period_guess / 100.0)
-    return traj.t, Rotation.from_quat(traj["quat"], scalar_first=True).as_rotvec()[:, 2]
+def _torsion(r, amplitude: float, period_guess: float, cycles: int):
+    """The Kane run of ``r`` released twisted by ``amplitude`` about the vertical, ~100 samples a period."""
+    return kane_run(r.with_initial(rotation=(0.0, 0.0, amplitude)), cycles * period_guess, period_guess / 100.0)

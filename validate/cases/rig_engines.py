@@ -12,6 +12,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 from scipy.integrate import solve_ivp
+from scipy.spatial.transform import Rotation
 from scipy.special import ellipk
 
 from bifilar.kane import KaneModel
@@ -19,7 +20,7 @@ from bifilar.statics import State, rest_pose
 
 from ..assets import rig
 from ..engines import engines
-from ..metrics import channel_difference, max_abs, period, quat_angle_difference
+from ..metrics import channel_difference, max_abs, period, quat_angle_difference, yaw
 from ..registry import CaseContext, Metric, case, check
 from ..trajectory import Trajectory
 
@@ -57,8 +58,6 @@ def run_all(r, duration: float, dt_out: float, state: State | None = None, names
 
 def thesis_angles(traj: Trajectory, model: KaneModel) -> np.ndarray:
     """The thesis's five angles at each sample of any rig trajectory."""
-    from scipy.spatial.transform import Rotation
-
     rot = Rotation.from_quat(traj["quat"], scalar_first=True).as_matrix()
     return np.array([model.angles(c, R) for c, R in zip(traj["com"], rot)])
 
@@ -132,19 +131,13 @@ def torsion_agreement(ctx: CaseContext, r, duration: float) -> list[Metric]:
     """The rig's [initial] torsion on every engine: MuJoCo's torsion period and agreement vs Kane."""
     runs = run_all(r, duration, 0.01)
     ctx.keep(*runs.values())
-    kane_period = period(runs["kane"].t, _yaw(runs["kane"])).value
+    kane_period = period(runs["kane"].t, yaw(runs["kane"])).value
     out = []
     for engine in MUJOCO:
-        measured = period(runs[engine].t, _yaw(runs[engine])).value
+        measured = period(runs[engine].t, yaw(runs[engine])).value
         out.append(check(f"{r.name}: {engine} torsion period vs kane over {duration:g} s",
                          abs(measured / kane_period - 1.0), AGREEMENT[engine].period, AGREEMENT[engine].reason))
     return out + [replace(m, name=f"{r.name}: {m.name}") for m in agreement_metrics(runs, rest_pose(r).tensions.mean())]
-
-
-def _yaw(traj: Trajectory) -> np.ndarray:
-    from scipy.spatial.transform import Rotation
-
-    return Rotation.from_quat(traj["quat"], scalar_first=True).as_rotvec()[:, 2]
 
 
 def double_pendulum(L1: float, L2: float, m: float, inertia: float, g: float, phi0, t: np.ndarray) -> np.ndarray:
@@ -172,8 +165,6 @@ def body_with_dimensions(ctx: CaseContext):
     r = rig("plate")
     rest = rest_pose(r)
     tilt = 0.3  # rad, about the CD line (body y)
-    from scipy.spatial.transform import Rotation
-
     rot = Rotation.from_rotvec([0.0, tilt, 0.0]).as_matrix()
     hinge = np.array([0.0, 0.0, 0.5])  # midpoint of CD at rest, world
     com = hinge + rot @ np.array([0.0, 0.0, -0.5])
