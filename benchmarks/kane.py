@@ -9,10 +9,10 @@ from __future__ import annotations
 import numpy as np
 from timing import best_of
 
-from bifilar import kane_kernel as K
-from bifilar.kane import KaneModel
-from bifilar.simulate import preferred_chart, simulate, state_to_chart
-from bifilar.statics import initial_state
+from bifilar.motion import kane_kernel as K
+from bifilar.motion.kane import KaneModel
+from bifilar.motion.simulate import preferred_chart, simulate, state_to_chart
+from bifilar.rig.statics import initial_state
 from validate.assets import rig
 
 

@@ -17,7 +17,7 @@ import mujoco
 import numpy as np
 
 from bifilar.rig import load_rig
-from bifilar.statics import rest_pose
+from bifilar.rig.statics import rest_pose
 from validate.engines import kane, mujoco_rig
 from validate.engines.mjcf import CHOSEN, Numerics
 from validate.metrics import energy_drift, period

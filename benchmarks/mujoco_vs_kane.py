@@ -16,7 +16,7 @@ import argparse
 import time
 from functools import partial
 
-from bifilar import lagrange
+from bifilar.motion import lagrange
 from bifilar.rig import load_rig
 from validate.engines import kane, mujoco_rig
 from validate.metrics import period

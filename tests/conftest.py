@@ -7,7 +7,7 @@ import pytest
 
 sys.path.insert(0, str(Path(__file__).parent))  # helper modules beside the tests (thesis_appendix)
 
-from bifilar.kane import KaneModel  # noqa: E402
+from bifilar.motion.kane import KaneModel  # noqa: E402
 from validate.assets import rig  # noqa: E402
 
 

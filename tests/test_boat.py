@@ -1,5 +1,5 @@
-"""The Solar Boat hung in a hall (bifilar/boat.py), its MuJoCo model (validate/boat_model.py), the study
-(validate/boat_study.py) and its command (validate/boat_cli.py), on models/solar_boat/suspension.toml."""
+"""The Solar Boat hung in a hall (bifilar/bodies/boat.py), its MuJoCo model (validate/studies/boat_model.py), the study
+(validate/studies/boat_study.py) and its command (validate/commands/boat.py), on models/solar_boat/suspension.toml."""
 
 from __future__ import annotations
 
@@ -16,13 +16,15 @@ import pytest
 from PIL import Image
 from scipy.spatial.transform import Rotation
 
-from bifilar import identify as ident
-from bifilar.boat import attachment_forces, load_suspension, lowest_point
-from bifilar.composite import mass_properties
+from bifilar.identification import identify as ident
+from bifilar.bodies.boat import attachment_forces, load_suspension, lowest_point
+from bifilar.bodies.composite import mass_properties
 from bifilar.rig import RigError
-from bifilar.statics import rest_pose
-from validate import boat_cli, boat_model, boat_study, cli
-from validate.boat_study import TIMED, axis_amplitude, run_study, summary
+from bifilar.rig.statics import rest_pose
+from validate import cli
+from validate.commands import boat as boat_cli
+from validate.studies import boat_model, boat_study
+from validate.studies.boat_study import TIMED, axis_amplitude, run_study, summary
 from validate.lineplot import nice_ticks
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -268,7 +270,7 @@ def test_a_hall_too_low_recommends_nothing(study):
     1 and 2 reach it and only 3 may be recommended; with it 1 m down, none."""
     from dataclasses import replace
 
-    from validate.boat_study import recommend
+    from validate.studies.boat_study import recommend
 
     low = replace(study, suspension=replace(study.suspension, hook_height=5.5))
     choice = recommend(low)

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from bifilar.composite import (
+from bifilar.bodies.composite import (
     SHAPES,
     load_parts,
     mass_properties,

@@ -8,15 +8,15 @@ import pytest
 from scipy.spatial.transform import Rotation
 from scipy.stats import binom
 
-from bifilar import identify as ident
-from bifilar import lagrange
-from bifilar.kane import KaneModel
-from bifilar.modes import linearize
-from bifilar.propagation import LEVEL, coverage, linear, monte_carlo
+from bifilar.identification import identify as ident
+from bifilar.motion import lagrange
+from bifilar.motion.kane import KaneModel
+from bifilar.motion.modes import linearize
+from bifilar.identification.propagation import LEVEL, coverage, linear, monte_carlo
 from bifilar.rig import RigError
-from bifilar.simulate import simulate
-from bifilar.statics import initial_state, length_errors
-from bifilar.tension_inertia import angular_acceleration, fit_inertia
+from bifilar.motion.simulate import simulate
+from bifilar.rig.statics import initial_state, length_errors
+from bifilar.identification.tension_inertia import angular_acceleration, fit_inertia
 from validate import cli
 from validate.assets import RIGS, rig
 from validate.cases.identify import SMALL, TABLE_7_1_1, thesis_rest

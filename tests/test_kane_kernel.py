@@ -5,9 +5,9 @@ import numpy as np
 import pytest
 from thesis_appendix import printed_beta, printed_V, printed_Vdot
 
-from bifilar import kane_kernel as K
-from bifilar.kane import POLAR, TILT
-from bifilar.statics import initial_state, rest_pose
+from bifilar.motion import kane_kernel as K
+from bifilar.motion.kane import POLAR, TILT
+from bifilar.rig.statics import initial_state, rest_pose
 
 H = 1e-6  # central differences: truncation ~H^2 = 1e-12, rounding ~1e-16/H = 1e-10 -> compare at 1e-8
 

@@ -8,9 +8,9 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-from bifilar import lagrange as L
-from bifilar.kane import KaneModel
-from bifilar.modes import linearize
+from bifilar.motion import lagrange as L
+from bifilar.motion.kane import KaneModel
+from bifilar.motion.modes import linearize
 from bifilar.rig import RigError
 from validate.assets import rig
 from validate.engines.kane import run as kane_run

@@ -4,9 +4,9 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from bifilar.kane import KaneModel
-from bifilar.modes import excite, linearize
-from bifilar.simulate import simulate
+from bifilar.motion.kane import KaneModel
+from bifilar.motion.modes import excite, linearize
+from bifilar.motion.simulate import simulate
 from validate.assets import rig
 from validate.metrics import period
 

@@ -17,7 +17,7 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 from bifilar.rig import RigError, load_rig
-from bifilar.statics import State, rest_pose
+from bifilar.rig.statics import State, rest_pose
 from validate.engines import kane, mjcf, mujoco_rig
 from validate.engines.mjcf import CHOSEN
 from validate.metrics import energy_drift, period

@@ -10,9 +10,9 @@ import mujoco
 import numpy as np
 import pytest
 
-from bifilar.seed001 import integrate, seed
-from bifilar.seed001.chain import Chain
-from bifilar.seed001.params import Params, load_params
+from bifilar.seeds.seed001 import integrate, seed
+from bifilar.seeds.seed001.chain import Chain
+from bifilar.seeds.seed001.params import Params, load_params
 from validate.assets import MODELS
 from validate.engines.seed001_mjcf import build_model
 from validate.engines.seed001_mujoco import Prober, simulate

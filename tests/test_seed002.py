@@ -5,7 +5,8 @@ import mujoco
 import numpy as np
 import pytest
 
-from bifilar import seed002, tmt
+from bifilar.seeds import seed002
+from bifilar.seeds import tmt
 from validate.engines import seed002_mujoco
 from validate.engines import tmt_mujoco as tm
 

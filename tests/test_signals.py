@@ -8,8 +8,8 @@ import pytest
 from scipy.integrate import solve_ivp
 from scipy.stats import binom
 
-from bifilar import lagrange as L
-from bifilar import signals as S
+from bifilar.motion import lagrange as L
+from bifilar.identification import signals as S
 from bifilar.rig import RigError
 from validate.assets import rig
 

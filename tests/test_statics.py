@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from bifilar.statics import attachments, initial_state, length_errors, rest_pose
+from bifilar.rig.statics import attachments, initial_state, length_errors, rest_pose
 from validate.assets import rig
 
 

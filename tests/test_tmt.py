@@ -7,8 +7,8 @@ import pytest
 from scipy.spatial.transform import Rotation
 from scipy.special import ellipk
 
-from bifilar import tmt
-from bifilar.tmt import Body, Chain, Frame
+from bifilar.seeds import tmt
+from bifilar.seeds.tmt import Body, Chain, Frame
 from validate.engines import tmt_mujoco as tm
 from validate.metrics import period
 

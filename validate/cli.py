@@ -12,7 +12,8 @@ import sys
 
 from bifilar.rig import RigError, load_rig
 
-from . import boat_cli, identify_cli
+from .commands import boat as boat_cli
+from .commands import identify as identify_cli
 from .argtypes import OneLineParser, UsageError, positive_float, whole_number
 
 
@@ -64,8 +65,8 @@ def main(argv: list[str] | None = None) -> int:
 
 
 def _cmd_modes(args) -> int:
-    from bifilar.kane import KaneModel
-    from bifilar.modes import linearize
+    from bifilar.motion.kane import KaneModel
+    from bifilar.motion.modes import linearize
 
     rig = load_rig(args.rig)
     lin = linearize(KaneModel.from_rig(rig))
@@ -94,7 +95,7 @@ def _cmd_modes(args) -> int:
 
 
 def _cmd_simulate(args) -> int:
-    from bifilar.simulate import IntegrationError, output_grid
+    from bifilar.motion.simulate import IntegrationError, output_grid
 
     from .engines import EngineInputError, engines
     from .trajectory import NonFiniteTrajectory, write_rig_csv

@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from bifilar.periods import Period, crossing_times, period  # noqa: F401  (metrics on trajectories)
+from bifilar.identification.periods import Period, crossing_times, period  # noqa: F401  (metrics on trajectories)
 
 from .trajectory import Trajectory
 

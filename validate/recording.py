@@ -30,7 +30,7 @@ import rerun as rr
 import rerun.blueprint as rrb
 from scipy.spatial.transform import Rotation
 
-from bifilar.composite import equivalent_box
+from bifilar.bodies.composite import equivalent_box
 
 from .registry import Metric
 from .trajectory import RIG_CHANNELS, Trajectory

@@ -22,7 +22,7 @@ from pathlib import Path
 import numpy as np
 from scipy.optimize import least_squares
 
-from bifilar.composite import MassProperties, mass_properties, parts_from_dict
+from bifilar.bodies.composite import MassProperties, mass_properties, parts_from_dict
 
 PARTS = Path(__file__).with_name("parts.toml")
 

@@ -27,11 +27,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from bifilar.boat import load_suspension
-from bifilar.statics import State
+from bifilar.bodies.boat import load_suspension
+from bifilar.rig.statics import State
 
-from ..boat_model import build_spec
-from ..boat_study import DT_OUT, SUSPENSION, run_study
+from ..studies.boat_model import build_spec
+from ..studies.boat_study import DT_OUT, SUSPENSION, run_study
 from ..engines import mujoco_rig
 from ..engines.kane import to_trajectory
 from ..metrics import max_abs, period

@@ -14,14 +14,14 @@ import numpy as np
 from scipy.optimize import brentq
 from scipy.stats import binom
 
-from bifilar import identify as ident
-from bifilar.kane import POLAR, KaneModel
-from bifilar.lagrange import from_rig as torsion_rig
-from bifilar.lagrange import period as torsion_period
-from bifilar.propagation import LEVEL, coverage
-from bifilar.simulate import simulate
-from bifilar.statics import Rest, initial_state, rest_pose
-from bifilar.tension_inertia import angular_acceleration, fit_inertia
+from bifilar.identification import identify as ident
+from bifilar.motion.kane import POLAR, KaneModel
+from bifilar.motion.lagrange import from_rig as torsion_rig
+from bifilar.motion.lagrange import period as torsion_period
+from bifilar.identification.propagation import LEVEL, coverage
+from bifilar.motion.simulate import simulate
+from bifilar.rig.statics import Rest, initial_state, rest_pose
+from bifilar.identification.tension_inertia import angular_acceleration, fit_inertia
 
 from ..assets import rig
 from ..registry import CaseContext, case, check

@@ -6,10 +6,10 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 from scipy.special import ellipk
 
-from bifilar.kane import POLAR, TILT, KaneModel
-from bifilar.modes import excite, linearize
-from bifilar.simulate import simulate
-from bifilar.statics import initial_state, rest_pose
+from bifilar.motion.kane import POLAR, TILT, KaneModel
+from bifilar.motion.modes import excite, linearize
+from bifilar.motion.simulate import simulate
+from bifilar.rig.statics import initial_state, rest_pose
 
 from ..assets import rig
 from ..engines.kane import to_trajectory

@@ -8,7 +8,7 @@ exactly the amount their quadratures predict: that is the "expected size of the 
 
 from __future__ import annotations
 
-from bifilar import lagrange as L
+from bifilar.motion import lagrange as L
 
 from ..assets import rig
 from ..engines.kane import run as kane_run

@@ -15,8 +15,8 @@ from scipy.integrate import solve_ivp
 from scipy.spatial.transform import Rotation
 from scipy.special import ellipk
 
-from bifilar.kane import KaneModel
-from bifilar.statics import State, rest_pose
+from bifilar.motion.kane import KaneModel
+from bifilar.rig.statics import State, rest_pose
 
 from ..assets import rig
 from ..engines import engines

@@ -17,8 +17,8 @@ from math import acos, pi
 import numpy as np
 from scipy.integrate import cumulative_simpson
 
-from bifilar.seed001 import integrate, seed
-from bifilar.seed001.params import Params, load_params
+from bifilar.seeds.seed001 import integrate, seed
+from bifilar.seeds.seed001.params import Params, load_params
 from validate.engines.seed001_mjcf import build_model
 from validate.engines.seed001_mujoco import MujocoRun, Prober, simulate
 

@@ -12,7 +12,8 @@ from functools import lru_cache
 import mujoco
 import numpy as np
 
-from bifilar import seed002, tmt
+from bifilar.seeds import seed002
+from bifilar.seeds import tmt
 from validate.engines import seed002_mujoco
 from validate.engines import tmt_mujoco as tm
 

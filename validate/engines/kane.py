@@ -4,10 +4,10 @@ from __future__ import annotations
 
 from scipy.spatial.transform import Rotation
 
-from bifilar.kane import KaneModel
+from bifilar.motion.kane import KaneModel
 from bifilar.rig import Rig
-from bifilar.simulate import KaneRun, simulate
-from bifilar.statics import State, initial_state
+from bifilar.motion.simulate import KaneRun, simulate
+from bifilar.rig.statics import State, initial_state
 
 from ..trajectory import Trajectory, rig_quaternions
 

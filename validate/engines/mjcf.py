@@ -33,9 +33,9 @@ import mujoco
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from bifilar.composite import equivalent_box
+from bifilar.bodies.composite import equivalent_box
 from bifilar.rig import Rig, RigError, load_rig
-from bifilar.statics import Rest, State, attachments, initial_state, rest_pose
+from bifilar.rig.statics import Rest, State, attachments, initial_state, rest_pose
 
 from ..trajectory import atomic_write_text
 

@@ -22,8 +22,8 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from bifilar.rig import Rig
-from bifilar.simulate import IntegrationError, output_grid
-from bifilar.statics import State, initial_state
+from bifilar.motion.simulate import IntegrationError, output_grid
+from bifilar.rig.statics import State, initial_state
 
 from ..trajectory import Trajectory, rig_quaternions
 from . import EngineInputError, mjcf

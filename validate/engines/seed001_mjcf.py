@@ -13,7 +13,7 @@ from pathlib import Path
 import mujoco
 import numpy as np
 
-from bifilar.seed001.params import Params
+from bifilar.seeds.seed001.params import Params
 
 PLATE_THICKNESS = 0.004  # m, drawing only
 

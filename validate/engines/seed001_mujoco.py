@@ -23,8 +23,8 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
-from bifilar.seed001.integrate import grid, steps_per_sample
-from bifilar.seed001.params import Params
+from bifilar.seeds.seed001.integrate import grid, steps_per_sample
+from bifilar.seeds.seed001.params import Params
 
 
 class Friction:

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import mujoco
 
-from bifilar.seed002 import BODIES, JOINTS, Params, chain, load
+from bifilar.seeds.seed002 import BODIES, JOINTS, Params, chain, load
 
 from .tmt_mujoco import chain_spec
 

@@ -27,7 +27,7 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
-from bifilar.tmt import Chain
+from bifilar.seeds.tmt import Chain
 
 
 def chain_spec(chain: Chain, joint_names: Sequence[str] | None = None, model_name: str = "chain") -> mujoco.MjSpec:

@@ -33,7 +33,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.integrate import quad
 
-from .rig import Rig, RigError
+from bifilar.rig import Rig, RigError
 
 # Relative tolerance of the period quadrature. The integrand is analytic on the closed interval
 # (see :func:`period`), so adaptive Gauss-Kronrod meets it in a few dozen evaluations.

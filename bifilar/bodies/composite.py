@@ -26,7 +26,7 @@ from typing import Callable
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from .checks import RigError, no_unknown, positive, read_toml, required, vector3
+from bifilar.rig.checks import RigError, no_unknown, positive, read_toml, required, vector3
 
 
 def _box(a: float, b: float, c: float) -> tuple[float, float, float]:

@@ -19,9 +19,9 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.integrate import solve_ivp
 
-from . import kane_kernel as K
-from .kane import POLAR, TILT, KaneModel, wire_angles
-from .statics import State, length_errors
+from bifilar.motion import kane_kernel as K
+from bifilar.motion.kane import POLAR, TILT, KaneModel, wire_angles
+from bifilar.rig.statics import State, length_errors
 
 _ENTER_TILT = 0.1  # leave POLAR when sin(theta2) falls below this
 _ENTER_POLAR = 0.95  # leave TILT when |u . n1| rises above this

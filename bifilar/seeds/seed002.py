@@ -22,9 +22,9 @@ from pathlib import Path
 
 import numpy as np
 
-from .tmt import Body, Chain, Frame
+from bifilar.seeds.tmt import Body, Chain, Frame
 
-MODEL_DIR = Path(__file__).resolve().parent.parent / "models" / "seed002"
+MODEL_DIR = Path(__file__).resolve().parents[2] / "models" / "seed002"
 PARAMS = MODEL_DIR / "params.toml"
 XML = MODEL_DIR / "seed002.xml"
 JOINTS = ("theta", "phi")  # q[0], q[1]: MuJoCo hinge names

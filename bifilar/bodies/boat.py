@@ -22,7 +22,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .checks import (
+from bifilar.rig.checks import (
     RigError,
     no_unknown,
     non_negative,
@@ -32,8 +32,8 @@ from .checks import (
     table,
     vector3,
 )
-from .composite import MassProperties, Part, load_parts, mass_properties, rig_body
-from .rig import Rig, rig_from_dict
+from bifilar.bodies.composite import MassProperties, Part, load_parts, mass_properties, rig_body
+from bifilar.rig import Rig, rig_from_dict
 
 _TOP_KEYS = {"parts", "deck", "hall", "configuration", "uncertainty"}
 _HALL_KEYS = {"hooks", "wire_length", "hook_height"}

@@ -42,13 +42,13 @@ import numpy as np
 from scipy.linalg import eigh
 from scipy.spatial.transform import Rotation
 
-from . import kane_kernel as K
-from .kane import KaneModel
-from .modes import NEUTRAL_RTOL, Modes, linearize
-from .periods import period as crossing_period
-from .rig import Rig, RigError
-from .simulate import simulate
-from .statics import Rest, State, taut_shift
+from bifilar.motion import kane_kernel as K
+from bifilar.motion.kane import KaneModel
+from bifilar.motion.modes import NEUTRAL_RTOL, Modes, linearize
+from bifilar.identification.periods import period as crossing_period
+from bifilar.rig import Rig, RigError
+from bifilar.motion.simulate import simulate
+from bifilar.rig.statics import Rest, State, taut_shift
 
 AXES = {"x": np.array([1.0, 0.0, 0.0]), "y": np.array([0.0, 1.0, 0.0]), "z": np.array([0.0, 0.0, 1.0])}
 

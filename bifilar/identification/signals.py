@@ -35,7 +35,7 @@ from numba import njit
 from scipy.optimize import least_squares
 from scipy.signal import lombscargle
 
-from .rig import RigError
+from bifilar.rig import RigError
 
 KINDS = ("angle", "rate")
 PARAMETERS = ("omega", "zeta", "quadratic", "theta0", "rate0", "offset", "drift")

@@ -18,10 +18,10 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.linalg import eigh
 
-from . import kane_kernel as K
-from .kane import KaneModel
-from .simulate import preferred_chart
-from .statics import Rest, State, rest_pose
+from bifilar.motion import kane_kernel as K
+from bifilar.motion.kane import KaneModel
+from bifilar.motion.simulate import preferred_chart
+from bifilar.rig.statics import Rest, State, rest_pose
 
 NEUTRAL_RTOL = 1e-9  # an eigenvalue below this fraction of the largest is neutral (or unstable)
 

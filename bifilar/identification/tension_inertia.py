@@ -25,8 +25,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .rig import Rig
-from .statics import anchors
+from bifilar.rig import Rig
+from bifilar.rig.statics import anchors
 
 ENTRIES = ("xx", "yy", "zz", "xy", "xz", "yz")
 

@@ -20,7 +20,7 @@ import numpy as np
 from scipy.optimize import least_squares, minimize
 from scipy.spatial.transform import Rotation
 
-from .rig import Rig, RigError
+from bifilar.rig import Rig, RigError
 
 
 @dataclass(frozen=True)

@@ -17,7 +17,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 if TYPE_CHECKING:
-    from .boat_study import Study
+    from ..studies.boat_study import Study
 
 FIGURE_SECONDS = 10.0  # s of each motion drawn: 2.4-5 periods
 COLOURS = ((31, 119, 180), (255, 127, 14), (44, 160, 44), (148, 103, 189), (140, 86, 75))  # per configuration
@@ -36,9 +36,9 @@ def add_parser(subparsers):
 def run(args) -> int:
     """Run the study (about 10 s) and print it; the study's modules are imported only here, so that
     ``python -m validate`` starts fast."""
-    from bifilar.boat import load_suspension
+    from bifilar.bodies.boat import load_suspension
 
-    from .boat_study import SUSPENSION, run_study, summary
+    from ..studies.boat_study import SUSPENSION, run_study, summary
 
     study = run_study(load_suspension(args.suspension or SUSPENSION))
     if args.png:
@@ -84,8 +84,8 @@ def report(data: dict) -> str:
 
 def tension_figure(study: Study, path: str | Path) -> Path:
     """One panel per motion: both wires' tensions in every configuration, rest tensions as thin lines."""
-    from .boat_study import AXIS_NAME
-    from .lineplot import Panel, Series, save_png
+    from ..studies.boat_study import AXIS_NAME
+    from ..lineplot import Panel, Series, save_png
 
     panels = []
     for k, motion in enumerate(study.configurations[0].loads):

@@ -30,9 +30,9 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from .smallmat import mm as _mm
-from .smallmat import mv as _mv
-from .smallmat import solve as _solve
+from bifilar.smallmat import mm as _mm
+from bifilar.smallmat import mv as _mv
+from bifilar.smallmat import solve as _solve
 
 POLAR, TILT = 0, 1
 

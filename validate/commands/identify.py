@@ -28,7 +28,7 @@ import numpy as np
 
 from bifilar.rig import RigError, load_rig
 
-from .argtypes import positive_float, whole_number
+from ..argtypes import positive_float, whole_number
 
 
 def add_parser(subparsers) -> None:
@@ -49,10 +49,10 @@ def add_parser(subparsers) -> None:
 
 def run(args) -> int:
     """Identify, propagate and print; returns the exit status (errors are raised for cli.main)."""
-    from bifilar.identify import identify
-    from bifilar.propagation import linear, monte_carlo
+    from bifilar.identification.identify import identify
+    from bifilar.identification.propagation import linear, monte_carlo
 
-    from .argtypes import UsageError
+    from ..argtypes import UsageError
 
     if args.signal is not None and args.amplitude is not None:
         raise UsageError("identify: --amplitude goes with --period; a --signal's amplitude is fitted")
@@ -100,8 +100,8 @@ def _signal_period(rig, args) -> tuple[float, float]:
     The fit needs the period-amplitude coefficient c of the mode, which depends (weakly) on the
     moment being sought: a first fit with c = 0 gives the moment at which c is then computed.
     """
-    from bifilar.identify import amplitude_coefficient, invert_period
-    from bifilar.signals import fit_csv
+    from bifilar.identification.identify import amplitude_coefficient, invert_period
+    from bifilar.identification.signals import fit_csv
 
     column = args.column or args.kind
     try:

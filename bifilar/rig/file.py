@@ -17,7 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .checks import (
+from bifilar.rig.checks import (
     RigError,
     inertia_tensor,
     no_unknown,

@@ -31,8 +31,8 @@ from dataclasses import dataclass, fields, replace
 import numpy as np
 from scipy.stats import norm
 
-from .identify import invert_period, linear_period, moment, pencil
-from .rig import Rig, Uncertainty, Wire
+from bifilar.identification.identify import invert_period, linear_period, moment, pencil
+from bifilar.rig import Rig, Uncertainty, Wire
 
 GROUPS = tuple(f.name for f in fields(Uncertainty))
 LEVEL = 0.95

@@ -15,9 +15,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import kane_kernel as K
-from .rig import Rig, RigError
-from .statics import State
+from bifilar.motion import kane_kernel as K
+from bifilar.rig import Rig, RigError
+from bifilar.rig.statics import State
 
 POLAR, TILT = K.POLAR, K.TILT
 

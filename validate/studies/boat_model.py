@@ -22,10 +22,10 @@ import mujoco
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from bifilar.boat import Suspension, load_suspension
-from bifilar.statics import Rest, rest_pose
+from bifilar.bodies.boat import Suspension, load_suspension
+from bifilar.rig.statics import Rest, rest_pose
 
-from .engines import mjcf
+from ..engines import mjcf
 
 CONFIGURATION = "1"  # the thesis's recommendation, hung in the shipped model
 TORSION = np.pi / 12  # rad, keyframe 'initial': the release of the thesis's Fig. 8.4.1
@@ -66,7 +66,7 @@ def build_spec(s: Suspension, configuration: str = CONFIGURATION, scene: bool = 
     rest = rest_pose(rig) if rest is None else rest
     spec = mjcf.build_spec(rig, rest=rest)
     spec.modelname = "solar_boat"
-    spec.comment += (f"  Drawn as the {len(s.parts)} parts of {s.source} (validate/boat_model.py); the box above\n"
+    spec.comment += (f"  Drawn as the {len(s.parts)} parts of {s.source} (validate/studies/boat_model.py); the box above\n"
                      f"  is geom group {HIDDEN_GROUP}, hidden. Keyframe 'initial': {TORSION:.6g} rad of torsion.\n")
     spec.geom("body").group = HIDDEN_GROUP
     body, visual = spec.body("body"), spec.find_default("visual")

@@ -40,8 +40,8 @@ import numpy as np
 from numba import njit
 from scipy.integrate import solve_ivp
 
-from .smallmat import mm as _mm
-from .smallmat import mv as _mv
+from bifilar.smallmat import mm as _mm
+from bifilar.smallmat import mv as _mv
 
 
 @dataclass(frozen=True)

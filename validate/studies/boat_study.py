@@ -26,17 +26,17 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from bifilar import identify as ident
-from bifilar.boat import Configuration, Suspension, attachment_forces, lowest_point
-from bifilar.identify import Identified
-from bifilar.kane import KaneModel
-from bifilar.modes import linearize
-from bifilar.propagation import Propagation, linear
+from bifilar.identification import identify as ident
+from bifilar.bodies.boat import Configuration, Suspension, attachment_forces, lowest_point
+from bifilar.identification.identify import Identified
+from bifilar.motion.kane import KaneModel
+from bifilar.motion.modes import linearize
+from bifilar.identification.propagation import Propagation, linear
 from bifilar.rig import Rig, RigError
-from bifilar.simulate import KaneRun, simulate
-from bifilar.statics import Rest, rest_pose
+from bifilar.motion.simulate import KaneRun, simulate
+from bifilar.rig.statics import Rest, rest_pose
 
-from .assets import MODELS
+from ..assets import MODELS
 
 SUSPENSION = MODELS / "solar_boat" / "suspension.toml"  # the shipped hall and configurations
 

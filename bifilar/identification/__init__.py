@@ -1,0 +1,2 @@
+"""Identification: moments of inertia from measured periods, signals or tensions, with their
+propagated uncertainty."""

@@ -1,0 +1,6 @@
+"""The rig: its file (body, wires, initial state, uncertainty), the field checks, and its statics
+(rest pose, static tensions, the initial state both engines start from)."""
+
+from bifilar.rig.file import Rig, RigError, Uncertainty, Wire, load_rig, rig_from_dict
+
+__all__ = ["Rig", "RigError", "Uncertainty", "Wire", "load_rig", "rig_from_dict"]

@@ -1,0 +1,1 @@
+"""Subcommands of ``python -m validate`` that have a module of their own."""
