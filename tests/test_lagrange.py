@@ -69,7 +69,7 @@ def test_printed_5_2_17_and_5_2_18_are_the_linear_model():
 def test_splayed_linear_period_matches_the_kane_linearisation():
     """T0 = 2 pi sqrt(4 H I / (m g b D)) for splayed wires (5.2.17 has D^2 and h); the Kane torsion
     mode comes from 4th-order differences good to ~1e-11 (tests/test_modes.py)."""
-    modes = linearize(KaneModel.from_rig(rig("plate"))).modes
+    modes = linearize(rig("plate")).modes
     torsion = [m for m in modes if abs(m.rotation[2]) > 0.99]
     assert len(torsion) == 1 and torsion[0].period == pytest.approx(L.linear_period(PLATE), rel=1e-10)
 

@@ -65,22 +65,22 @@ def main(argv: list[str] | None = None) -> int:
 
 
 def _cmd_modes(args) -> int:
-    from bifilar.motion.kane import KaneModel
     from bifilar.motion.modes import linearize
 
     rig = load_rig(args.rig)
-    lin = linearize(KaneModel.from_rig(rig))
+    lin = linearize(rig)
     rest = lin.rest
     report = {
         "rig": rig.name,
-        "engine": "kane",
+        "model": "pose-coordinate linearisation (bifilar.motion.modes)",
         "equilibrium": {
             "com": rest.com.tolist(),
             "rotation": rest.rotation.tolist(),
             "tensions": rest.tensions.tolist(),
         },
         "modes": [
-            {"period": m.period, "omega2": m.omega2, "com_shape": m.com.tolist(), "rotation_shape": m.rotation.tolist()}
+            {"motion": m.motion, "period": m.period, "frequency": m.frequency, "omega2": m.omega2,
+             "com_shape": m.com.tolist(), "rotation_shape": m.rotation.tolist()}
             for m in lin.modes
         ],
     }
@@ -89,8 +89,9 @@ def _cmd_modes(args) -> int:
         return 0
     print(f"rig {rig.name}: rest COM {_fmt(rest.com)} m, tensions {_fmt(rest.tensions)} N")
     for i, m in enumerate(lin.modes, start=1):
-        period = "neutral/unstable" if m.period is None else f"{m.period:.9g} s"
-        print(f"  mode {i}: period {period}; COM shape {_fmt(m.com)} m, rotation shape {_fmt(m.rotation)} rad")
+        period = "neutral" if m.period is None else f"{m.period:.9g} s ({m.frequency:.6g} Hz)"
+        print(f"  mode {i} ({m.motion}): period {period}; COM shape {_fmt(m.com)} m, "
+              f"rotation shape {_fmt(m.rotation)} rad")
     return 0
 
 

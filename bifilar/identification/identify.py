@@ -5,13 +5,14 @@ One moment is unknown: J = e^T I e about a body axis e (a unit vector in the bod
 only along e, I(J) = I + (J - e^T I e) e e^T: the other entries are held, and for a principal axis e
 only that principal moment changes. A measured period of the mode that turns about e then fixes J.
 
-Exact and cheap. At rest the stiffness K of :func:`bifilar.modes.linearize` holds gravity and the
+Exact and cheap. At rest the stiffness K of :func:`bifilar.motion.modes.linearize` holds gravity and the
 wires only, and the mass matrix is linear in the inertia, so with the rest pose computed once
 
-    M(J) = M(J0) + (J - J0) w w^T,   w = G_new^T R e,
+    M(J) = M(J0) + (J - J0) w w^T,   w = G^T R e,
 
-(G_new: partial angular velocities of the four independent speeds, R: rest rotation body -> world).
-Every period at every J is then a 4x4 generalised eigenproblem with all four modes and their coupling;
+(G: angular velocity per independent speed, the rotation half of the null-space basis of the wire
+constraints; R: rest rotation body -> world). Every period at every J is then an n x n generalised
+eigenproblem (n = 4 for two wires) with all the modes and their coupling;
 nothing is truncated as in the thesis's 2x2 systems.
 
 Which mode belongs to the axis. For K v = w2 M v with v^T M v = 1, Hellmann-Feynman gives
@@ -42,7 +43,6 @@ import numpy as np
 from scipy.linalg import eigh
 from scipy.spatial.transform import Rotation
 
-from bifilar.motion import kane_kernel as K
 from bifilar.motion.kane import KaneModel
 from bifilar.motion.modes import NEUTRAL_RTOL, Modes, linearize
 from bifilar.identification.periods import period as crossing_period
@@ -56,7 +56,7 @@ _STEP = 0.05  # first Newton step limit in ln(J - J_min): 5 %, small enough to f
 _OVERLAP = 0.99  # |v_new^T M v_old| above which the step limit may double (up to 1 in ln J)
 _REACH = np.log(1e6)  # J - J_min is searched within a factor 1e6 of the rig's own value
 _MAX_STEPS = 2 * int(_REACH / _STEP)  # enough to cross the search range twice at the smallest limit
-_TOL = 1e-13  # |ln T - ln T_measured| at the root: rounding of a 4x4 eigenproblem
+_TOL = 1e-13  # |ln T - ln T_measured| at the root: rounding of a small eigenproblem
 _ROUNDING = 1e3 * np.finfo(float).eps  # eigh's absolute error on w2, relative to the largest w2
 # Amplitude correction: the fixed point J -> J(T / ratio(J)) contracts by ~A^2 per pass.
 _AMPLITUDE_RTOL = 1e-9
@@ -94,14 +94,14 @@ class Pencil:
     axis: np.ndarray  # e, body frame
     lin: Modes  # at the rig's own moment J0
     rotation: np.ndarray  # rest pose, body -> world (the frame of lin.mass)
-    partial_com: np.ndarray  # V_new (3x4): COM velocity (world) per independent speed
-    partial_omega: np.ndarray  # G_new (3x4): angular velocity (world) per independent speed
+    partial_com: np.ndarray  # (3 x n): COM velocity (world) per independent speed
+    partial_omega: np.ndarray  # (3 x n): angular velocity (world) per independent speed
     moment0: float  # J0
     floor: float  # J_min: I(J) is positive definite for J > J_min
 
     @property
     def w(self) -> np.ndarray:
-        """G_new^T R e: angular velocity about the axis per independent speed."""
+        """G^T R e: angular velocity about the axis per independent speed."""
         return self.partial_omega.T @ (self.rotation @ self.axis)
 
     def mass(self, value: float) -> np.ndarray:
@@ -127,15 +127,11 @@ class Pencil:
 def pencil(rig: Rig, axis, rest: Rest | None = None) -> Pencil:
     """Linearise the rig once (about ``rest``, default its computed rest pose) for any moment about
     ``axis``."""
-    model = KaneModel.from_rig(rig)
-    lin = linearize(model, rest)
-    kin = K.kinematics(lin.theta0, np.zeros(5), model.p, lin.chart)
-    # linearize's inertia in world axes is R I R^T, R = (n~ frame) frame_in_body^T
-    rotation = kin[1] @ model.frame_in_body.T
+    lin = linearize(rig, rest)
     e = axis_vector(axis)
     j0 = moment(rig, e)
     floor = j0 - 1.0 / float(e @ np.linalg.solve(rig.inertia, e))
-    return Pencil(e, lin, rotation, kin[3] @ lin.tangent, kin[4] @ lin.tangent, j0, floor)
+    return Pencil(e, lin, lin.rest.rotation, lin.partial_com, lin.partial_omega, j0, floor)
 
 
 @dataclass(frozen=True)

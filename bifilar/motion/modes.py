@@ -1,14 +1,21 @@
-"""Small oscillations of a rig about its rest pose, from the exact linearisation of the Kane equations.
+"""Small oscillations of a rig about its rest pose, in pose coordinates, for any number of wires.
 
-With theta5 eliminated through the constraint, the four independent angles q = theta_{1..4} move as
-theta = theta0 + T dq, T = [I4; gamma^T] (5.1.4). Linearising M4(theta) theta'' = N4(theta, theta')
-about rest (where N4 = 0 and the velocity terms are quadratic) gives
+The body's small displacement is q = (x, theta) (COM shift and rotation vector, world frame; see
+:mod:`bifilar.rig.pose_kernel`). The wires allow q = Z dq, Z a basis of the null space of the wire
+constraints' gradients (n = 6 - rank of them: 4 for two wires, 3 for three), and
 
-    M dq'' + K dq = 0,   M = M4 T = m V_new^T V_new + G_new^T I G_new,   K = -(dN4/dtheta) T,
+    M dq'' + K dq = 0,   M = Z^T diag(m I, R I R^T) Z,   K = Z^T (sum_i t_i hess g_i) Z,
 
-all four modes coupled, unlike the thesis's reduced 2x2 systems of ch. 7.1. M is symmetric positive
-definite; K is the Hessian of the potential on the constraint manifold (symmetric to rounding, which
-is checked). dN4/dtheta is a fourth-order central difference of the compiled N4, accurate to ~1e-11.
+with t_i the static tensions. K is the Hessian of the potential on the constraint manifold, exact and
+closed-form: no finite differences and no angles, so no rig is near a coordinate singularity (the
+thesis's angles theta_1..5 have one where the attachment line turns steeply, which made the earlier
+linearisation through them wrong there). On two-wire rigs it agrees with the exact linearisation of the
+Kane-Tseng equations where their chart is regular (case ``kane-modes-spectrum``, tests/test_modes.py).
+
+Each mode is named by the motion that holds most of its kinetic energy: ``sway x`` / ``sway y`` (COM
+along world x / y), ``yaw`` (turning about world z) or ``tilt`` (turning about a horizontal axis, with
+the COM's vertical motion). Modes of equal frequency (a symmetric trifilar's two sways) are resolved
+deterministically, along world x, y, then the rotations, instead of eigh's arbitrary basis.
 """
 
 from __future__ import annotations
@@ -18,78 +25,132 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.linalg import eigh
 
-from bifilar.motion import kane_kernel as K
-from bifilar.motion.kane import KaneModel
-from bifilar.motion.simulate import preferred_chart
-from bifilar.rig.statics import Rest, State, rest_pose
+from bifilar.rig import Rig
+from bifilar.rig import pose_kernel as PK
+from bifilar.rig.statics import NULL_RTOL, Rest, State, anchors, arms, rest_pose, rig_scale
 
 NEUTRAL_RTOL = 1e-9  # an eigenvalue below this fraction of the largest is neutral (or unstable)
+DEGENERATE_RTOL = 1e-9  # eigenvalues closer than this fraction of the largest are one frequency
+MOTIONS = ("sway x", "sway y", "yaw", "tilt")
+# Pose directions (x, theta) tried in this order to resolve a degenerate eigenspace.
+_PREFERRED = np.eye(6)[[0, 1, 5, 3, 4, 2]]
 
 
 @dataclass(frozen=True)
 class Mode:
-    """One normal mode: period (s; None if neutral or unstable), omega^2 (rad^2/s^2), and its shape as
-    a COM displacement (world, m) and a small rotation vector (world, rad), scaled so that the largest
-    of |rotation| and |com|/r_ref is 1."""
+    """One normal mode: period (s; None if neutral or unstable), omega^2 (rad^2/s^2), its shape as a
+    COM displacement (world, m) and a small rotation vector (world, rad), scaled so that the largest
+    of |rotation| and |com| / r_ref is 1, and the motion it is (one of :data:`MOTIONS`)."""
 
     period: float | None
     omega2: float
     com: np.ndarray
     rotation: np.ndarray
+    motion: str
+
+    @property
+    def frequency(self) -> float | None:
+        """Hz."""
+        return None if self.period is None else 1.0 / self.period
 
 
 @dataclass(frozen=True)
 class Modes:
     rest: Rest
     modes: tuple[Mode, ...]  # longest period first; neutral/unstable modes first of all
-    mass: np.ndarray  # M (4x4)
-    stiffness: np.ndarray  # K (4x4)
-    chart: int
-    theta0: np.ndarray
-    tangent: np.ndarray  # T (5x4)
+    mass: np.ndarray  # M (n x n)
+    stiffness: np.ndarray  # K (n x n)
+    basis: np.ndarray  # Z (6 x n): pose displacement (x, theta; world) per independent coordinate
+
+    @property
+    def partial_com(self) -> np.ndarray:
+        """COM velocity (world, 3 x n) per independent speed."""
+        return self.basis[:3]
+
+    @property
+    def partial_omega(self) -> np.ndarray:
+        """Angular velocity (world, 3 x n) per independent speed."""
+        return self.basis[3:]
 
 
-def linearize(model: KaneModel, rest: Rest | None = None) -> Modes:
+def reduced(rig: Rig, rest: Rest) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(Z, M, K) about ``rest`` (see the module docstring)."""
+    z, mr, kr, _ = PK.reduced_matrices(
+        rest.com, rest.rotation, rest.tensions, arms(rig), anchors(rig), rig.inertia, rig.mass,
+        rig_scale(rig), NULL_RTOL,
+    )
+    return z, mr, kr
+
+
+def motion_of(rig: Rig, rest: Rest, com: np.ndarray, rotation: np.ndarray) -> str:
+    """The motion holding most of the kinetic energy of a shape (COM and rotation, world)."""
+    inertia = rest.rotation @ rig.inertia @ rest.rotation.T
+    horizontal = np.array([rotation[0], rotation[1], 0.0])
+    energy = {
+        "sway x": rig.mass * com[0] ** 2,
+        "sway y": rig.mass * com[1] ** 2,
+        "yaw": inertia[2, 2] * rotation[2] ** 2,
+        "tilt": horizontal @ inertia @ horizontal + rig.mass * com[2] ** 2,
+    }
+    return max(MOTIONS, key=energy.__getitem__)
+
+
+def _resolve_degenerate(w2: np.ndarray, vecs: np.ndarray, z: np.ndarray, m6: np.ndarray) -> np.ndarray:
+    """Eigenvectors with every degenerate eigenspace spanned along :data:`_PREFERRED` directions
+    (M-orthonormal, by Gram-Schmidt), each with its largest pose component positive."""
+    vecs = vecs.copy()
+    scale = max(abs(w2).max(), 1e-300)
+    k = 0
+    while k < len(w2):
+        j = k + 1
+        while j < len(w2) and w2[j] - w2[k] <= DEGENERATE_RTOL * scale:
+            j += 1
+        if j - k > 1:
+            space = vecs[:, k:j]
+            chosen = []
+            for direction in _PREFERRED:
+                v = space @ (space.T @ (z.T @ m6 @ direction))  # M-projection onto the eigenspace
+                for c in chosen:
+                    v = v - c * (c @ (z.T @ m6 @ z) @ v)
+                norm = np.sqrt(v @ (z.T @ m6 @ z) @ v)
+                if norm > 1e-6 * np.sqrt(np.abs(m6).max()):
+                    chosen.append(v / norm)
+                if len(chosen) == j - k:
+                    break
+            vecs[:, k:j] = np.array(chosen).T
+        k = j
+    for col in range(vecs.shape[1]):
+        shape = z @ vecs[:, col]
+        if shape[np.argmax(np.abs(shape))] < 0.0:
+            vecs[:, col] = -vecs[:, col]
+    return vecs
+
+
+def linearize(rig: Rig, rest: Rest | None = None) -> Modes:
     """Mass and stiffness matrices about the rest pose and the normal modes."""
-    rest = rest_pose(model.rig) if rest is None else rest
-    at_rest = State(rest.com, rest.rotation, np.zeros(3), np.zeros(3))
-    chart = preferred_chart(model, at_rest)
-    theta0 = model.angles(rest.com, rest.rotation, chart)
-    p = model.p
-    zero = np.zeros(5)
-    kin = K.kinematics(theta0, zero, p, chart)
-    V, G, d, J = kin[3], kin[4], kin[7], kin[8]
-    beta = 2.0 * (J.T @ d)
-    T = np.vstack([np.eye(4), -beta[:4] / beta[4]])
-    Vn, Gn = V @ T, G @ T
-    Iw = K.inertia_world(kin[1], p)
-    M = model.mass * (Vn.T @ Vn) + Gn.T @ Iw @ Gn
-    dN = np.empty((4, 4))
-    h = 1e-4
-    for j in range(4):
-        def n4(s):
-            return K.eom(theta0 + s * T[:, j], zero, p, chart)[1][:4]
-        dN[:, j] = (-n4(2 * h) + 8 * n4(h) - 8 * n4(-h) + n4(-2 * h)) / (12 * h)
-    Kmat = -dN
-    asym = np.abs(Kmat - Kmat.T).max() / max(np.abs(Kmat).max(), 1e-300)
-    if asym > 1e-6:
-        raise RuntimeError(f"stiffness matrix is not symmetric (relative asymmetry {asym:.1e}): not a rest pose")
-    Kmat = 0.5 * (Kmat + Kmat.T)
-    w2, vecs = eigh(Kmat, M)
-    scale = max(model.b_prime, model.r, 1e-3)
+    rest = rest_pose(rig) if rest is None else rest
+    z, mr, kr = reduced(rig, rest)
+    if z.shape[1] == 0:
+        return Modes(rest, (), mr, kr, z)
+    w2, vecs = eigh(kr, mr)
+    m6 = np.zeros((6, 6))
+    m6[:3, :3] = rig.mass * np.eye(3)
+    m6[3:, 3:] = rest.rotation @ rig.inertia @ rest.rotation.T
+    vecs = _resolve_degenerate(w2, vecs, z, m6)
+    scale = max(np.linalg.norm(arms(rig), axis=1).max(), 1e-3)
     modes = []
-    for k in range(4):
-        dtheta = T @ vecs[:, k]
-        com, rot = V @ dtheta, G @ dtheta
+    for k in range(len(w2)):
+        shape = z @ vecs[:, k]
+        com, rot = shape[:3], shape[3:]
         norm = max(np.linalg.norm(rot), np.linalg.norm(com) / scale)
         neutral = w2[k] <= NEUTRAL_RTOL * max(abs(w2).max(), 1e-300)
         period = None if neutral else float(2.0 * np.pi / np.sqrt(w2[k]))
-        modes.append(Mode(period, float(w2[k]), com / norm, rot / norm))
+        modes.append(Mode(period, float(w2[k]), com / norm, rot / norm, motion_of(rig, rest, com, rot)))
     modes.sort(key=lambda m: (m.period is not None, -(m.period or 0.0)))
-    return Modes(rest, tuple(modes), M, Kmat, chart, theta0, T)
+    return Modes(rest, tuple(modes), mr, kr, z)
 
 
-def excite(model: KaneModel, lin: Modes, index: int, amplitude: float) -> State:
+def excite(lin: Modes, index: int, amplitude: float) -> State:
     """A state at the rest pose moving along mode ``index`` with angle amplitude ~``amplitude`` (rad):
     the velocity is omega_k times the mode shape, which is tangent to the wire constraints."""
     mode = lin.modes[index]

@@ -21,6 +21,17 @@ from scipy.optimize import least_squares, minimize
 from scipy.spatial.transform import Rotation
 
 from bifilar.rig import Rig, RigError
+from bifilar.rig import pose_kernel as PK
+
+# Newton on the equilibrium equations converges quadratically: 30 iterations is ample from any start
+# SLSQP hands it; a residual of 1e-12 (forces / weight, lengths / rig size) is machine precision on
+# ordinary rigs and ~1e-13 of the weight where a Jacobian is nearly singular.
+_NEWTON_ITERATIONS = 30
+_RESIDUAL = 1e-12
+# Constraint rows whose singular value is below this fraction of the largest are dependent.
+NULL_RTOL = 1e-9
+# An omega^2 below -this fraction of the largest is a real instability, not rounding.
+_NEUTRAL_SLACK = 1e-9
 
 
 @dataclass(frozen=True)
@@ -80,12 +91,65 @@ def _equilibrium_residual(x: np.ndarray, rig: Rig, rotation0: np.ndarray, scale:
     return np.concatenate([force / weight, moment / (weight * scale), (dist - lengths(rig)) / scale])
 
 
-def rest_pose(rig: Rig) -> Rest:
+def rig_scale(rig: Rig) -> float:
+    """A length (m) that makes the rig's equations dimensionless: its longest wire or anchor span."""
+    return float(max(lengths(rig).max(), np.ptp(anchors(rig), axis=0).max(), 1e-3))
+
+
+def arms(rig: Rig) -> np.ndarray:
+    """Attachment points relative to the COM, body frame (n_wires x 3, m)."""
+    return np.array([w.attach - rig.com for w in rig.wires])
+
+
+def rest_pose(rig: Rig, guess: Rest | None = None) -> Rest:
     """The stable rest pose and static tensions, to machine precision.
 
-    Raises :class:`RigError` if no pose holds both wires taut (a wire would have to push).
+    From ``guess`` (a rest pose of a nearby rig: continuation in a sweep) Newton's method alone
+    finds it; otherwise, or if that fails, the minimum of the potential with every wire at its
+    length (SLSQP) is polished by Newton's method on the equilibrium equations (force and moment
+    balance, wire lengths, the tensions as unknowns; compiled, analytic Jacobian). The result is
+    checked: every wire pulls and the pose is stable (no direction on the constraint manifold
+    lowers the potential).
+
+    Raises :class:`RigError` if no pose holds every wire taut (a wire would have to push) or the
+    equilibrium found is not stable.
     """
-    scale = float(max(lengths(rig).max(), np.ptp(anchors(rig), axis=0).max(), 1e-3))
+    if guess is not None:
+        rest = _polish(rig, guess.com, guess.rotation, guess.tensions)
+        if rest is not None and _stable(rig, rest):
+            return rest
+    return _global_rest_pose(rig)
+
+
+def _polish(rig: Rig, com: np.ndarray, rotation: np.ndarray, tensions: np.ndarray) -> Rest | None:
+    """Newton's method on the equilibrium equations from a pose and tensions; None if it fails."""
+    weight = rig.mass * rig.gravity
+    com, rotation, tensions, residual, _ = PK.newton_equilibrium(
+        np.asarray(com, float), np.asarray(rotation, float), np.asarray(tensions, float),
+        arms(rig), anchors(rig), lengths(rig), weight, rig_scale(rig), _NEWTON_ITERATIONS,
+    )
+    if not residual <= _RESIDUAL:
+        return None
+    return Rest(com=com, rotation=rotation, tensions=tensions)
+
+
+def _stable(rig: Rig, rest: Rest) -> bool:
+    """Every wire pulls and the stiffness on the constraint manifold has no negative direction."""
+    if np.any(rest.tensions <= 0.0):
+        return False
+    z, mr, kr, _ = PK.reduced_matrices(
+        rest.com, rest.rotation, rest.tensions, arms(rig), anchors(rig), rig.inertia, rig.mass,
+        rig_scale(rig), NULL_RTOL,
+    )
+    if z.shape[1] == 0:
+        return True
+    w2 = np.linalg.eigvalsh(np.linalg.solve(np.linalg.cholesky(mr), np.linalg.solve(np.linalg.cholesky(mr), kr).T))
+    return bool(w2.min() >= -_NEUTRAL_SLACK * max(abs(w2).max(), 1e-300))
+
+
+def _global_rest_pose(rig: Rig) -> Rest:
+    """The rest pose without a guess: SLSQP on the potential, then :func:`_polish`."""
+    scale = rig_scale(rig)
     # Start slightly turned: a symmetric start can be a stationary point that is not a minimum
     # (a body balanced upside down); the minimiser must see a gradient to roll off it.
     rotation0 = Rotation.from_rotvec([0.03, 0.02, 0.01]).as_matrix()
@@ -116,32 +180,39 @@ def rest_pose(rig: Rig) -> Rest:
     # Tension guess from force balance alone, then Newton on the full equilibrium equations.
     span = anchors(rig) - attachments(rig, com, rotation0)
     dirs = span / np.linalg.norm(span, axis=1)[:, None]
-    t0 = np.linalg.lstsq(dirs.T, np.array([0.0, 0.0, 1.0]), rcond=None)[0]
-    sol = least_squares(
-        _equilibrium_residual,
-        np.concatenate([com, np.zeros(3), t0]),
-        args=(rig, rotation0, scale),
-        method="lm",
-        xtol=1e-15,
-        ftol=1e-15,
-        gtol=1e-15,
-    )
-    residual = float(np.abs(sol.fun).max())
-    # Dimensionless (forces / weight, lengths / rig size); 1e-16 on ordinary rigs, ~1e-9 where the
-    # Jacobian is singular (a COM on CD between vertical wires: two neutral directions).
-    if residual > 1e-7:
-        raise RigError(rig.source, "wire", f"no equilibrium with every wire taut (residual {residual:.2e})")
-    rotation = Rotation.from_rotvec(sol.x[3:6]).as_matrix() @ rotation0
-    tensions = sol.x[6:] * rig.mass * rig.gravity
-    slack = np.flatnonzero(tensions <= 0.0)
+    t0 = np.linalg.lstsq(dirs.T, np.array([0.0, 0.0, 1.0]), rcond=None)[0] * rig.mass * rig.gravity
+    rest = _polish(rig, com, rotation0, t0)
+    if rest is None:
+        # A singular equilibrium Jacobian (a COM on the line of two attachments: a neutral tilt)
+        # defeats plain Newton; Levenberg-Marquardt still converges there.
+        sol = least_squares(
+            _equilibrium_residual,
+            np.concatenate([com, np.zeros(3), t0 / (rig.mass * rig.gravity)]),
+            args=(rig, rotation0, scale),
+            method="lm",
+            xtol=1e-15,
+            ftol=1e-15,
+            gtol=1e-15,
+        )
+        residual = float(np.abs(sol.fun).max())
+        # Dimensionless (forces / weight, lengths / rig size); 1e-16 on ordinary rigs, ~1e-9 where
+        # the Jacobian is singular (a COM on CD between vertical wires: two neutral directions).
+        if residual > 1e-7:
+            raise RigError(rig.source, "wire", f"no equilibrium with every wire taut (residual {residual:.2e})")
+        rotation = Rotation.from_rotvec(sol.x[3:6]).as_matrix() @ rotation0
+        rest = Rest(com=sol.x[:3].copy(), rotation=rotation, tensions=sol.x[6:] * rig.mass * rig.gravity)
+    slack = np.flatnonzero(rest.tensions <= 0.0)
     if slack.size:
         i = int(slack[0])
         raise RigError(
             rig.source,
             f"wire[{i + 1}]",
-            f"would be slack at rest (tension {tensions[i]:.6g} N): the body cannot hang taut on every wire",
+            f"would be slack at rest (tension {rest.tensions[i]:.6g} N): the body cannot hang taut on every wire",
         )
-    return Rest(com=sol.x[:3].copy(), rotation=_nearest_on_neutral_axis(rig, sol.x[:3], rotation), tensions=tensions)
+    rest = Rest(rest.com, _nearest_on_neutral_axis(rig, rest.com, rest.rotation), rest.tensions)
+    if not _stable(rig, rest):
+        raise RigError(rig.source, "wire", "the only equilibrium with every wire taut found is unstable: no rest pose")
+    return rest
 
 
 def _nearest_on_neutral_axis(rig: Rig, com: np.ndarray, rotation: np.ndarray) -> np.ndarray:

@@ -192,7 +192,7 @@ class ConfigurationStudy:
 def study_configuration(s: Suspension, config: Configuration) -> ConfigurationStudy:
     rig = s.rig(config)
     rest = rest_pose(rig)
-    slowest = max(m.period for m in linearize(KaneModel.from_rig(rig), rest).modes if m.period is not None)
+    slowest = max(m.period for m in linearize(rig, rest).modes if m.period is not None)
     moments = tuple(time_moment(rig, config, m, rest) for m in TIMED)
     loads = tuple(load_run(s, rig, m, rest, PERIODS * slowest) for m in LOADED)
     depth, _ = depth_under_hooks(s, rig, rest.com, rest.rotation)

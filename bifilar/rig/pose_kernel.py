@@ -1,0 +1,180 @@
+"""Compiled geometry of a rigid body on N inextensible wires, in pose coordinates.
+
+A pose is the COM position c (world, m) and the rotation R (body -> world). Small displacements are
+q = (x, theta): c = c0 + x and R = exp([theta]x) R0 (theta a rotation vector in the world frame), so
+that at q = 0 the velocities are (c', omega) = q'. Wire i runs from the anchor a_i (world) to the
+attachment p_i = c + R r_i (r_i: attachment minus COM, body frame); its arm is s_i = R r_i, its length
+rho_i = |a_i - p_i| and its direction towards the anchor u_i = (a_i - p_i) / rho_i.
+
+To first order dp_i = dx - [s_i]x dtheta, so the constraint g_i = rho_i - L_i has the gradient
+
+    grad g_i = [-u_i^T, (u_i x s_i)^T],
+
+and to second order, with the second-order term (1/2)[theta]x^2 s_i of the exponential map,
+
+    hess g_i = P_i^T (I - u_i u_i^T) P_i / rho_i - blockdiag(0, (u_i s_i^T + s_i u_i^T) / 2 - (u_i . s_i) I),
+
+P_i = [I, -[s_i]x]. A wire of tension t_i pulls the body with t_i u_i; the equilibrium of the weight
+W = m g (along world -z) is the stationary point of the Lagrangian W c_z + sum t_i g_i, whose Hessian
+restricted to the null space Z of the constraint gradients is the stiffness of small oscillations:
+K = Z^T (sum t_i hess g_i) Z (the potential W c_z is linear in q). Nothing here passes through angles,
+so no pose is a coordinate singularity. Everything is derived in ``docs/pose-coordinates.md``.
+"""
+
+from __future__ import annotations
+
+import numba as nb
+import numpy as np
+
+
+@nb.njit(cache=True)
+def cross_matrix(v):
+    """[v]x, the matrix of v x (.)."""
+    out = np.zeros((3, 3))
+    out[0, 1], out[0, 2] = -v[2], v[1]
+    out[1, 0], out[1, 2] = v[2], -v[0]
+    out[2, 0], out[2, 1] = -v[1], v[0]
+    return out
+
+
+@nb.njit(cache=True)
+def rotation_vector_matrix(theta):
+    """exp([theta]x) by Rodrigues' formula (series near zero)."""
+    angle = np.sqrt(theta @ theta)
+    k = cross_matrix(theta)
+    if angle < 1e-8:
+        return np.eye(3) + k + 0.5 * (k @ k)
+    return np.eye(3) + (np.sin(angle) / angle) * k + ((1.0 - np.cos(angle)) / angle**2) * (k @ k)
+
+
+@nb.njit(cache=True)
+def wire_geometry(com, rot, arms, anchors):
+    """Per wire: arm s_i = R r_i (world), direction u_i to the anchor and distance rho_i."""
+    n = arms.shape[0]
+    s = np.empty((n, 3))
+    u = np.empty((n, 3))
+    rho = np.empty(n)
+    for i in range(n):
+        s[i] = rot @ arms[i]
+        d = anchors[i] - com - s[i]
+        rho[i] = np.sqrt(d @ d)
+        u[i] = d / rho[i]
+    return s, u, rho
+
+
+@nb.njit(cache=True)
+def constraint_jacobian(s, u):
+    """Rows grad g_i = [-u_i, u_i x s_i] (N x 6)."""
+    n = s.shape[0]
+    jac = np.empty((n, 6))
+    for i in range(n):
+        jac[i, :3] = -u[i]
+        jac[i, 3:] = np.cross(u[i], s[i])
+    return jac
+
+
+@nb.njit(cache=True)
+def constraint_hessian(s, u, rho, i):
+    """hess g_i in q = (x, theta) at q = 0 (6 x 6, symmetric)."""
+    proj = np.eye(3) - np.outer(u[i], u[i])
+    pmat = np.zeros((3, 6))
+    pmat[:, :3] = np.eye(3)
+    pmat[:, 3:] = -cross_matrix(s[i])
+    h = pmat.T @ proj @ pmat / rho[i]
+    h[3:, 3:] -= 0.5 * (np.outer(u[i], s[i]) + np.outer(s[i], u[i])) - (u[i] @ s[i]) * np.eye(3)
+    return h
+
+
+@nb.njit(cache=True)
+def equilibrium_residual(com, rot, tensions, arms, anchors, lengths, weight, scale):
+    """Force balance / W, moment balance about the COM / (W scale) and length errors / scale
+    (6 + N), and its Jacobian with respect to (x, theta, t / W)."""
+    n = arms.shape[0]
+    s, u, rho = wire_geometry(com, rot, arms, anchors)
+    res = np.zeros(6 + n)
+    jac = np.zeros((6 + n, 6 + n))
+    res[2] = -1.0
+    for i in range(n):
+        t = tensions[i] / weight
+        res[:3] += t * u[i]
+        res[3:6] += t * np.cross(s[i], u[i]) / scale
+        res[6 + i] = (rho[i] - lengths[i]) / scale
+        # du = -(I - u u^T) / rho dp,  dp = dx - [s]x dtheta,  ds = dtheta x s = -[s]x dtheta
+        proj = (np.eye(3) - np.outer(u[i], u[i])) / rho[i]
+        sx = cross_matrix(s[i])
+        du_dx = -proj
+        du_dth = proj @ sx
+        ux = cross_matrix(u[i])
+        jac[:3, :3] += t * du_dx
+        jac[:3, 3:6] += t * du_dth
+        jac[:3, 6 + i] = u[i]
+        # d(s x u) = ds x u + s x du = [u]x [s]x dtheta + [s]x du
+        jac[3:6, :3] += t * (sx @ du_dx) / scale
+        jac[3:6, 3:6] += t * (ux @ sx + sx @ du_dth) / scale
+        jac[3:6, 6 + i] = np.cross(s[i], u[i]) / scale
+        jac[6 + i, :3] = -u[i] / scale
+        jac[6 + i, 3:6] = np.cross(u[i], s[i]) / scale
+    return res, jac
+
+
+@nb.njit(cache=True)
+def newton_equilibrium(com, rot, tensions, arms, anchors, lengths, weight, scale, max_iter):
+    """Newton's method on :func:`equilibrium_residual` from a guess. Returns the pose, the tensions,
+    the final max-norm residual and the number of iterations (max_iter + 1 if it did not converge)."""
+    com = com.copy()
+    rot = rot.copy()
+    t = tensions / weight
+    n = arms.shape[0]
+    best = np.inf
+    for it in range(max_iter):
+        res, jac = equilibrium_residual(com, rot, t * weight, arms, anchors, lengths, weight, scale)
+        err = np.abs(res).max()
+        if err < 1e-14:
+            return com, rot, t * weight, err, it
+        if not np.isfinite(err) or err > 1e6 * min(best, 1.0) + 1.0:
+            break
+        best = min(best, err)
+        step = np.linalg.solve(jac, -res)
+        if not np.all(np.isfinite(step)):
+            break
+        # Limit the turn and the shift per step: Newton far from the solution may jump to the
+        # inverted equilibrium; a damped step keeps it in the basin it started in.
+        shrink = max(1.0, np.sqrt(step[3:6] @ step[3:6]) / 0.2, np.sqrt(step[:3] @ step[:3]) / (0.2 * scale))
+        step /= shrink
+        com += step[:3]
+        rot = rotation_vector_matrix(step[3:6]) @ rot
+        t += step[6 : 6 + n]
+    res, jac = equilibrium_residual(com, rot, t * weight, arms, anchors, lengths, weight, scale)
+    return com, rot, t * weight, np.abs(res).max(), max_iter + 1
+
+
+@nb.njit(cache=True)
+def reduced_matrices(com, rot, tensions, arms, anchors, inertia_body, mass, scale, null_tol):
+    """Small oscillations about an equilibrium pose: the null-space basis Z (6 x n) of the wire
+    constraints, the mass matrix Z^T diag(m I, R I R^T) Z and the stiffness Z^T (sum t_i hess g_i) Z.
+
+    Z comes from the SVD of the constraint Jacobian with its rotation columns multiplied by the rig
+    size ``scale`` (m), so that both halves are lengths: directions whose singular value is below
+    ``null_tol`` times the largest are free; ``rank`` is the number of independent constraints.
+    """
+    n = arms.shape[0]
+    s, u, rho = wire_geometry(com, rot, arms, anchors)
+    jac = constraint_jacobian(s, u)
+    jac[:, 3:] /= scale
+    _, sv, vt = np.linalg.svd(jac)
+    rank = 0
+    for k in range(sv.shape[0]):
+        if sv[k] > null_tol * sv[0]:
+            rank += 1
+    z = np.ascontiguousarray(vt[rank:, :].T)
+    z[3:, :] /= scale
+    m6 = np.zeros((6, 6))
+    for k in range(3):
+        m6[k, k] = mass
+    m6[3:, 3:] = rot @ inertia_body @ rot.T
+    k6 = np.zeros((6, 6))
+    for i in range(n):
+        k6 += tensions[i] * constraint_hessian(s, u, rho, i)
+    mr = z.T @ m6 @ z
+    kr = z.T @ k6 @ z
+    return z, 0.5 * (mr + mr.T), 0.5 * (kr + kr.T), rank
