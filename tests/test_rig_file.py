@@ -62,7 +62,8 @@ def test_three_wires_are_rejected_by_the_kane_engine(tmp_path, capsys):
     path = tmp_path / "three.toml"
     extra = "\n[[wire]]\nanchor = [1.0, 0.0, 4.83]\nattach = [1.0, 0.0, 0.5]\nlength = 4.33\n"
     path.write_text(GOOD.replace("[initial]", extra + "\n[initial]"))
-    code, _, err = run_cli(capsys, "modes", str(path))
+    code, _, err = run_cli(capsys, "simulate", str(path), "--engine", "kane", "--duration", "1",
+                           "--out", str(tmp_path / "out.csv"))
     assert code == 2
     assert "wire" in err and err.count("\n") == 1
 
