@@ -63,10 +63,11 @@ class BudgetSpent(IntegrationError):
 @dataclass(frozen=True)
 class Budget:
     """The most work one run may do: right-hand-side evaluations per simulated second (plus a floor)
-    and wall-clock seconds (None: unbounded). The plate needs ~2e3 evaluations per simulated second at
-    rtol 1e-10 (benchmarks/kane.py; 1.5e5 evaluations per wall second), a spin at the rig file's
-    largest allowed ``initial.omega`` ~1e5; the default allows 1e6, i.e. about 7 wall seconds per
-    simulated second before it stops a run."""
+    and wall-clock seconds (None: unbounded). The plate in torsion needs ~270 evaluations per simulated
+    second at rtol 1e-10 (tests/test_robust.py), and the evaluations run at ~1.5e5 per wall second
+    (benchmarks/kane.py); the default allows 1e6 per simulated second, some 4000 times an ordinary
+    run, i.e. about 7 wall seconds per simulated second before it stops a run whose steps shrink
+    without end."""
 
     rhs_per_second: float = 1e6
     rhs_floor: int = 1_000_000
