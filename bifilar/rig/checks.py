@@ -32,6 +32,8 @@ def read_text_file(path: str | Path, max_bytes: int = MAX_FILE_BYTES) -> str:
     every problem is a :class:`RigError` on field ``file``. Opened non-blocking, so that a pipe is
     refused without waiting for a writer."""
     src = str(path)
+    if not src:
+        raise RigError("''", "file", "no file name given (an empty argument)")
     try:
         fd = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0))
     except OSError as exc:
