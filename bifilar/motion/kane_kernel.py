@@ -30,6 +30,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from bifilar.jit import announce_compile
 from bifilar.smallmat import mm as _mm
 from bifilar.smallmat import mv as _mv
 from bifilar.smallmat import solve as _solve
@@ -248,3 +249,8 @@ def observe(Y, p, chart):
         Iw = inertia_world(R, p)
         energy[i] = 0.5 * m * (vel[i] @ vel[i]) + 0.5 * (omg[i] @ _mv(Iw, omg[i])) + m * g * c[2]
     return com, frames, vel, omg, tension, err2, energy
+
+
+def announce() -> None:
+    """Say in one line if the kernels are about to be compiled (:func:`bifilar.jit.announce_compile`)."""
+    announce_compile("the Kane kernels", rhs, observe, loads, eom, pose)

@@ -17,6 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
+from bifilar.rig.ranges import MAX_WIRES, check_ranges
 from bifilar.rig.checks import (
     RigError,
     inertia_tensor,
@@ -29,7 +30,7 @@ from bifilar.rig.checks import (
     vector3,
 )
 
-__all__ = ["Rig", "RigError", "Uncertainty", "Wire", "load_rig", "rig_from_dict", "check_reachable"]
+__all__ = ["Rig", "RigError", "Uncertainty", "Wire", "load_rig", "rig_from_dict", "check_reachable", "check_hanging"]
 
 
 @dataclass(frozen=True)
@@ -107,8 +108,8 @@ def rig_from_dict(data: dict, source: str = "<memory>", default_name: str = "rig
     wires_raw = data.get("wire")
     if not isinstance(wires_raw, list) or not all(isinstance(w, dict) for w in wires_raw):
         raise RigError(source, "wire", "missing: give the wires as [[wire]] tables")
-    if len(wires_raw) < 2:
-        raise RigError(source, "wire", f"two [[wire]] tables needed, found {len(wires_raw)}")
+    if not 2 <= len(wires_raw) <= MAX_WIRES:
+        raise RigError(source, "wire", f"2 to {MAX_WIRES} [[wire]] tables needed, found {len(wires_raw)}")
     wires = []
     for i, w in enumerate(wires_raw, start=1):
         prefix = f"wire[{i}]."
@@ -144,6 +145,7 @@ def rig_from_dict(data: dict, source: str = "<memory>", default_name: str = "rig
         uncertainty=unc,
         source=source,
     )
+    check_ranges(rig)
     check_reachable(rig)
     return rig
 
@@ -152,14 +154,12 @@ def check_reachable(rig: Rig) -> None:
     """Raise unless the two wires, the anchor span and the attachment span can close a loop.
 
     The loop anchor A -> attach -> attach -> anchor B is a quadrilateral with sides |AB|, l, b', l';
-    a taut pose exists only if no side is longer than the sum of the other three, and the body
-    needs two distinct attachment points to be held by two wires.
+    a taut pose exists only if no side is longer than the sum of the other three (distinct
+    attachment points are checked with the ranges, :mod:`bifilar.rig.ranges`).
     """
     w1, w2 = rig.wires[0], rig.wires[1]
     span_top = float(np.linalg.norm(w1.anchor - w2.anchor))
     span_body = float(np.linalg.norm(w1.attach - w2.attach))
-    if span_body < 1e-9:
-        raise RigError(rig.source, "wire[2].attach", "coincides with wire[1].attach; the body would hang from one point")
     sides = {"anchor span": span_top, "wire[1].length": w1.length,
              "attachment span": span_body, "wire[2].length": w2.length}
     total = sum(sides.values())
@@ -173,3 +173,15 @@ def check_reachable(rig: Rig) -> None:
             )
 
 
+
+
+def check_hanging(rig: Rig, rest) -> None:
+    """Raise unless every wire hangs down from its anchor at the rest pose ``rest`` (a
+    :class:`bifilar.rig.statics.Rest`): an anchor below its attachment (the sign of a z flipped) makes a
+    guy wire, not a pendulum, though its tension may well be positive."""
+    for i, w in enumerate(rig.wires, start=1):
+        attach = rest.com + rest.rotation @ (w.attach - rig.com)
+        rise = float(w.anchor[2] - attach[2])
+        if rise <= 0.0:
+            raise RigError(rig.source, f"wire[{i}].anchor", f"is {-rise:.6g} m below (or level with) its attachment "
+                           "at rest: a wire must hang down from its anchor (is the sign of z right?)")
