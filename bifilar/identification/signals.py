@@ -36,7 +36,7 @@ The fit, robust over 150 cycles:
 1. start: a Lomb-Scargle peak and a closed-form damped sinusoid over the first :data:`FIRST_CYCLES`
    cycles, its frequency mapped to the zero-amplitude one through the law at the measured amplitude
    (:func:`AmplitudeLaw.ratio`), so that the start is right at any amplitude;
-2. continuation: the window doubles until it holds the whole record, each fit starting from the
+2. continuation: the window grows :data:`GROWTH`-fold until it holds the whole record, each fit starting from the
    last, so that the phase cannot slip by a cycle (a 1 % frequency error over 150 cycles would);
 3. glitches: a soft-L1 loss while the window grows, then samples beyond :data:`OUTLIER_Z` robust
    standard deviations (1.4826 MAD) are rejected and reported, and the inliers refitted by ordinary
@@ -66,6 +66,7 @@ from bifilar.identification.records import KINDS, MIN_SAMPLES, Record
 MIN_CYCLES = 2.0  # fewer cycles in the record and the periodogram cannot locate the peak
 MIN_SNR = 3.0  # the fitted swing's RMS against the residual's; a noise-only fit reaches ~0.2-0.5
 FIRST_CYCLES = 4.0  # first window: long enough for a periodogram, short enough that A barely decays
+GROWTH = 3.0  # window growth per stage: a fit of N cycles predicts the phase over 3N to << 1 cycle
 OUTLIER_Z = 6.0  # robust sigmas: a normal sample exceeds it with probability 2e-9 (none in 1e6 samples)
 EXCESS_PRIOR = 0.5  # prior std of ds / s: a real rig's amplitude law may differ by tens of percent
 SECOND_MODE_POWER = 60.0  # peak / local median of the residual periodogram: noise peaks reach ~10-15
@@ -237,10 +238,11 @@ def fit_oscillation(t, y, kind: str, law: AmplitudeLaw = LINEAR, second_mode: bo
     kept = np.ones(len(tau), dtype=bool)
     while True:
         window = tau <= end
-        p = _solve(spec, p, window, robust=True)
-        if end >= tau[-1]:
+        last = end >= tau[-1]
+        p = _solve(spec, p, window, robust=True, tol=1e-8 if last else 1e-6)  # a stage is only a start
+        if last:
             break
-        end = min(2.0 * end, tau[-1])
+        end = min(GROWTH * end, tau[-1])
     # 3. outliers: reject, refit the inliers by least squares, until the set stops changing
     p, kept = _reject(spec, p)
     # 4. a second mode in the residual
@@ -304,14 +306,14 @@ def _bounds(spec: _Spec, p: np.ndarray):
     return lo, hi
 
 
-def _solve(spec: _Spec, p: np.ndarray, mask: np.ndarray, robust: bool):
-    """Least squares on the samples in ``mask``; soft-L1 at 3 robust sigmas when ``robust``."""
+def _solve(spec: _Spec, p: np.ndarray, mask: np.ndarray, robust: bool, tol: float = 1e-10):
+    """Least squares on the samples in ``mask`` to relative ``tol``; soft-L1 at 3 robust sigmas when
+    ``robust``."""
     r = _residual(spec, p, mask)[: int(mask.sum())]
     spec.noise = max(1.4826 * float(np.median(np.abs(r - np.median(r)))), 1e-300)
     lo, hi = _bounds(spec, p)
     p = np.where(p <= lo, lo + 1e-9 * np.abs(p[0]) * (lo == 0.0), p)  # a bound reached by the last fit
     kw = dict(loss="soft_l1", f_scale=3.0 * spec.noise) if robust else {}
-    tol = 1e-10 if robust else 1e-12
     sol = least_squares(lambda q: _residual(spec, q, mask), p, bounds=(lo, hi), x_scale="jac", method="trf",
                         xtol=tol, ftol=tol, gtol=tol, **kw)
     return sol.x
@@ -319,15 +321,16 @@ def _solve(spec: _Spec, p: np.ndarray, mask: np.ndarray, robust: bool):
 
 def _reject(spec: _Spec, p: np.ndarray):
     """Step 3: inliers within :data:`OUTLIER_Z` robust sigmas, refitted until the set is stable."""
-    kept = np.ones(len(spec.tau), dtype=bool)
+    kept = None
     for _ in range(4):
         r = spec.model(p, spec.tau) - spec.y
-        sigma = 1.4826 * float(np.median(np.abs(r[kept] - np.median(r[kept]))))
-        new = np.abs(r - np.median(r[kept])) <= OUTLIER_Z * sigma
-        p = _solve(spec, p, new, robust=False)
-        if np.array_equal(new, kept):
+        inl = r if kept is None else r[kept]
+        sigma = 1.4826 * float(np.median(np.abs(inl - np.median(inl))))
+        new = np.abs(r - np.median(inl)) <= OUTLIER_Z * sigma
+        if kept is not None and np.array_equal(new, kept):
             break
         kept = new
+        p = _solve(spec, p, kept, robust=False)
     return p, kept
 
 
@@ -496,10 +499,10 @@ def _acceleration(theta, rate, omega, zeta, quadratic, exact, rho, lam, kappa):
     w2 = omega * omega
     damping = 2.0 * zeta * omega * rate + quadratic * abs(rate) * rate
     if exact:
-        half = math.sin(0.5 * theta)
+        half, co = math.sin(0.5 * theta), math.cos(0.5 * theta)
         r = math.sqrt(max(1.0 - rho * half * half, 1e-12))
-        u = math.sin(theta) / r
-        v = math.cos(theta) / r + 0.25 * rho * u * u / r
+        u = 2.0 * half * co / r  # sin(theta) / r
+        v = (1.0 - 2.0 * half * half) / r + 0.25 * rho * u * u / r  # cos(theta) / r + ...
         restoring = w2 * u * (1.0 + lam * v * rate * rate) / (1.0 + lam * w2 * u * u) + w2 * kappa * theta**3
     else:
         restoring = w2 * theta * (1.0 + kappa * theta * theta)
