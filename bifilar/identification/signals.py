@@ -65,6 +65,10 @@ from bifilar.identification.records import KINDS, MIN_SAMPLES, Record
 
 MIN_CYCLES = 2.0  # fewer cycles in the record and the periodogram cannot locate the peak
 MIN_SNR = 3.0  # the fitted swing's RMS against the residual's; a noise-only fit reaches ~0.2-0.5
+# the start's sinusoid against the rest of the first cycles: noise alone gives ~sqrt(2 / samples),
+# a second mode as large as the first ~1
+START_SNR = 0.7
+START_SAMPLES = 100  # at least this many samples in the first window: noise alone then gives < 0.4
 FIRST_CYCLES = 4.0  # first window: long enough for a periodogram, short enough that A barely decays
 GROWTH = 3.0  # window growth per stage: a fit of N cycles predicts the phase over 3N to << 1 cycle
 OUTLIER_Z = 6.0  # robust sigmas: a normal sample exceeds it with probability 2e-9 (none in 1e6 samples)
@@ -233,6 +237,9 @@ def fit_oscillation(t, y, kind: str, law: AmplitudeLaw = LINEAR, second_mode: bo
         raise ValueError(f"the record holds {cycles:.3g} cycles; at least {MIN_CYCLES:g} are needed")
 
     spec, p = _start(tau, y, kind, law, omega_mean)
+    cycles = p[0] * tau[-1] / (2.0 * math.pi)
+    if cycles < MIN_CYCLES:
+        raise ValueError(f"the record holds {cycles:.3g} cycles; at least {MIN_CYCLES:g} are needed")
     # 2. continuation over a doubling window, robust loss
     end = FIRST_CYCLES * 2.0 * math.pi / omega_mean
     kept = np.ones(len(tau), dtype=bool)
@@ -258,10 +265,16 @@ def fit_oscillation(t, y, kind: str, law: AmplitudeLaw = LINEAR, second_mode: bo
 def _start(tau, y, kind, law, omega_mean):
     """The parameter layout and the amplitude-aware start from the first cycles (step 1)."""
     first = tau <= FIRST_CYCLES * 2.0 * math.pi / omega_mean
-    if first.sum() < MIN_SAMPLES:
-        first = np.arange(len(tau)) < MIN_SAMPLES
+    if first.sum() < START_SAMPLES:
+        first = np.arange(len(tau)) < START_SAMPLES
     omega_d, alpha, c, s, offset, drift = _damped_sinusoid(tau[first], y[first], omega_mean)
     omega_d = abs(omega_d)
+    swing = np.exp(-alpha * tau[first]) * (c * np.cos(omega_d * tau[first]) + s * np.sin(omega_d * tau[first]))
+    rest = y[first] - offset - drift * tau[first] - swing
+    snr = math.sqrt(float(np.mean(swing**2))) / max(1.4826 * float(np.median(np.abs(rest))), 1e-300)
+    if snr < START_SNR:  # refused before the costly stages
+        raise ValueError(f"no oscillation stands out of the noise in the first {FIRST_CYCLES:g} cycles (sinusoid "
+                         f"/ residual RMS = {snr:.2g} < {START_SNR:g})")
     rate_out = kind == "rate"
     amplitude = math.hypot(c, s) / (omega_d if rate_out else 1.0)
     omega = math.hypot(omega_d, alpha)
