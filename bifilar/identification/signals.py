@@ -41,8 +41,8 @@ The fit, robust over 150 cycles:
 3. glitches: a soft-L1 loss while the window grows, then samples beyond :data:`OUTLIER_Z` robust
    standard deviations (1.4826 MAD) are rejected and reported, and the inliers refitted by ordinary
    least squares;
-4. a second mode: if the residual periodogram has a peak :data:`SECOND_MODE_POWER` times its local
-   median away from the first mode and its harmonics, a damped sinusoid is added and everything refitted.
+4. a second mode: if the residual periodogram has a peak :data:`SECOND_MODE_POWER` times its median
+   over an octave either side (its own lobe, the first mode and its harmonics left out), a damped sinusoid is added and everything refitted.
 
 Uncertainty: the sandwich covariance with residual scores summed over blocks of consecutive samples
 (batch means), the block :data:`BLOCK_TAUS` integrated autocorrelation times of the residual long, so
@@ -213,14 +213,18 @@ class _Spec:
         return out
 
 
-def fit_record(record: Record, law: AmplitudeLaw = LINEAR, second_mode: bool = True) -> OscillationFit:
+def fit_record(record: Record, law: AmplitudeLaw = LINEAR, second_mode: bool = True,
+               excess_prior: float = EXCESS_PRIOR) -> OscillationFit:
     """:func:`fit_oscillation` of a :class:`~bifilar.identification.records.Record`."""
-    return fit_oscillation(record.t, record.y, record.kind, law, second_mode)
+    return fit_oscillation(record.t, record.y, record.kind, law, second_mode, excess_prior)
 
 
-def fit_oscillation(t, y, kind: str, law: AmplitudeLaw = LINEAR, second_mode: bool = True) -> OscillationFit:
+def fit_oscillation(t, y, kind: str, law: AmplitudeLaw = LINEAR, second_mode: bool = True,
+                    excess_prior: float = EXCESS_PRIOR) -> OscillationFit:
     """Fit the module's model to samples ``y`` at increasing times ``t`` (see the module docstring).
 
+    ``excess_prior``: the prior std of ds / s (0: the law exactly, no excess fitted). A record whose
+    amplitude hardly decays cannot tell T0 from the law: its period sigma then carries this prior.
     Raises ValueError naming what is wrong with a record that cannot be used.
     """
     if kind not in KINDS:
@@ -236,7 +240,7 @@ def fit_oscillation(t, y, kind: str, law: AmplitudeLaw = LINEAR, second_mode: bo
     if cycles < MIN_CYCLES:
         raise ValueError(f"the record holds {cycles:.3g} cycles; at least {MIN_CYCLES:g} are needed")
 
-    spec, p = _start(tau, y, kind, law, omega_mean)
+    spec, p = _start(tau, y, kind, law, omega_mean, excess_prior)
     cycles = p[0] * tau[-1] / (2.0 * math.pi)
     if cycles < MIN_CYCLES:
         raise ValueError(f"the record holds {cycles:.3g} cycles; at least {MIN_CYCLES:g} are needed")
@@ -262,7 +266,7 @@ def fit_oscillation(t, y, kind: str, law: AmplitudeLaw = LINEAR, second_mode: bo
     return _result(spec, p, kept, t, y)
 
 
-def _start(tau, y, kind, law, omega_mean):
+def _start(tau, y, kind, law, omega_mean, excess_prior):
     """The parameter layout and the amplitude-aware start from the first cycles (step 1)."""
     first = tau <= FIRST_CYCLES * 2.0 * math.pi / omega_mean
     if first.sum() < START_SAMPLES:
@@ -291,7 +295,7 @@ def _start(tau, y, kind, law, omega_mean):
         names.append("gain")  # rad^2 per signal unit^2: the square of the unknown scale
         p.append(0.0)
     elif law.kind != "linear":
-        prior = EXCESS_PRIOR * abs(law.coefficient(omega))
+        prior = excess_prior * abs(law.coefficient(omega))
         if prior > 0.0:
             names.append("excess")
             p.append(0.0)
@@ -360,8 +364,9 @@ def _second_mode(spec: _Spec, p: np.ndarray, kept: np.ndarray):
         near |= np.abs(grid - k * p[0]) < 4.0 * resolution
     power = np.where(near, 0.0, power)
     j = int(np.argmax(power))
-    band = (grid > 0.75 * grid[j]) & (grid < 1.25 * grid[j]) & ~near
-    if power[j] < SECOND_MODE_POWER * float(np.median(power[band])):
+    # the local noise floor: an octave either side, without the peak's own lobe and the first mode's
+    band = (grid > 0.5 * grid[j]) & (grid < 2.0 * grid[j]) & ~near & (np.abs(grid - grid[j]) > 3.0 * resolution)
+    if not band.any() or power[j] < SECOND_MODE_POWER * float(np.median(power[band])):
         return None
     w2, a2, c2, s2, _, _ = _damped_sinusoid(tau, r, grid[j])
     return np.array([abs(w2), a2, c2, s2 * np.sign(w2)])

@@ -21,7 +21,7 @@ from scipy.stats import chi2
 
 from bifilar.identification.identify import AXES, Pencil, amplitude_coefficient, axis_vector, invert_period, pencil
 from bifilar.identification.records import Record
-from bifilar.identification.signals import AmplitudeLaw, OscillationFit, fit_record
+from bifilar.identification.signals import EXCESS_PRIOR, AmplitudeLaw, OscillationFit, fit_record
 from bifilar.motion import lagrange
 from bifilar.rig import Rig, RigError
 
@@ -52,7 +52,7 @@ class Trial:
     sensitivity: float
 
 
-def fit_trial(rig: Rig, axis, record: Record, p: Pencil | None = None) -> Trial:
+def fit_trial(rig: Rig, axis, record: Record, p: Pencil | None = None, excess_prior: float = EXCESS_PRIOR) -> Trial:
     """Fit ``record`` with the rig's law and invert its period (see the module docstring).
 
     A series law depends weakly on the moment: it is recomputed at the identified moment and the
@@ -62,12 +62,12 @@ def fit_trial(rig: Rig, axis, record: Record, p: Pencil | None = None) -> Trial:
     p = pencil(rig, axis) if p is None else p
     law = law_for(rig, axis)
     try:
-        fit = fit_record(record, law)
+        fit = fit_record(record, law, excess_prior=excess_prior)
         found = invert_period(rig, axis, fit.period, p=p)
         if law.kind == "series":
             better = law_for(found.rig, axis)
             if abs(better.s - law.s) > _LAW_RTOL * abs(law.s):
-                fit = fit_record(record, better)
+                fit = fit_record(record, better, excess_prior=excess_prior)
                 found = invert_period(rig, axis, fit.period, p=p)
     except RigError as exc:
         if exc.field != "period":

@@ -36,6 +36,22 @@ from bifilar.rig import RigError, load_rig
 
 from ..argtypes import UsageError, positive_float, whole_number
 
+
+def non_negative_float(name: str):
+    """A finite number >= 0 (argparse type; one-line error naming the option)."""
+    import argparse
+
+    def parse(text: str) -> float:
+        try:
+            value = float(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{name} must be a number, got {text!r}") from None
+        if not math.isfinite(value) or value < 0.0:
+            raise argparse.ArgumentTypeError(f"{name} must be a non-negative finite number, got {text!r}")
+        return value
+
+    return parse
+
 AXIS_INDEX = {"x": 0, "y": 1, "z": 2}
 WEAK_SENSITIVITY = 0.02  # d ln T / d ln I below this: the period barely depends on the moment
 
@@ -59,6 +75,9 @@ def add_parser(subparsers) -> None:
     p.add_argument("--angle-unit", choices=("rad", "deg"), default="rad", help="angle (or rate) unit (default rad)")
     p.add_argument("--from", dest="start", type=float, metavar="S", help="use the record from this time, s")
     p.add_argument("--to", dest="end", type=float, metavar="S", help="use the record up to this time, s")
+    p.add_argument("--law-sigma", type=non_negative_float("--law-sigma"), default=None, metavar="F",
+                   help="relative std allowed for the real rig's amplitude law against the ideal one "
+                        "(default 0.5; 0: the ideal law exactly)")
     p.add_argument("--tare", metavar="FIXTURE.toml", help="the fixture alone, to subtract")
     tare = p.add_mutually_exclusive_group()
     tare.add_argument("--tare-period", type=positive_float("--tare-period"), help="the fixture's period, s")
@@ -95,7 +114,7 @@ def _check_options(args) -> None:
     if args.signal is not None and args.amplitude is not None:
         raise UsageError("identify: --amplitude goes with --period; a --signal's amplitude is fitted")
     uses_signal = args.signal is not None or args.tare_signal is not None
-    record_options = {"--column": args.column, "--time-column": args.time_column, "--fps": args.fps,
+    record_options = {"--law-sigma": args.law_sigma, "--column": args.column, "--time-column": args.time_column, "--fps": args.fps,
                       "--from": args.start, "--to": args.end}
     record_options["--kind"] = None if args.kind == "angle" else args.kind
     record_options["--time-unit"] = None if args.time_unit == "s" else args.time_unit
@@ -136,6 +155,7 @@ def _identify(path: str, args, period, signals, amplitude="args"):
     """(report dict, trials) for one rig file (the rig, or a --tare fixture)."""
     from bifilar.identification.identify import identify, pencil
     from bifilar.identification.records import read_record
+    from bifilar.identification.signals import EXCESS_PRIOR
     from bifilar.identification.trials import fit_trial, pool
 
     axis = args.axis
@@ -160,7 +180,8 @@ def _identify(path: str, args, period, signals, amplitude="args"):
         for name in signals:
             record = read_record(name, args.column, args.kind, time_column=args.time_column, fps=args.fps,
                                  time_unit=args.time_unit, angle_unit=args.angle_unit, start=args.start, end=args.end)
-            trials.append(fit_trial(rig, axis, record, p))
+            prior = EXCESS_PRIOR if args.law_sigma is None else args.law_sigma
+            trials.append(fit_trial(rig, axis, record, p, prior))
         pooled = pool(trials)
         small, small_std, ratio = pooled.period, pooled.period_std, 1.0
         period_std_source = "the records' fits"
