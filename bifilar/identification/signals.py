@@ -26,10 +26,13 @@ The amplitude law f (:class:`AmplitudeLaw`) is the rig's own, not a cubic stand-
 * ``linear``: f = theta.
 
 Where the real rig's amplitude dependence differs from the ideal law (wire stretch, finite hooks),
-the excess cubic k_x = -8 ds / 3 is fitted, ds the excess period-amplitude coefficient, with a
+for the exact law the excess cubic k_x = -8 ds / 3 is fitted, ds the excess period-amplitude coefficient, with a
 Gaussian prior of standard deviation :data:`EXCESS_PRIOR` times the law's own s: a decaying record
 determines ds itself, a record at one amplitude leaves it at the prior, whose width then enters the
-period's standard deviation as model error. ``amplitude_coefficient`` = s + ds is reported.
+period's standard deviation as model error. ``amplitude_coefficient`` = s + ds is reported. The
+series law is not fitted (over a coupled mode the waveform's harmonics differ from a cubic's and
+would set ds wrongly): the same relative uncertainty of its s enters the period's variance as
+(omega EXCESS_PRIOR s <A^2>)^2, <A^2> the mean of the first and last cycle's squared amplitudes.
 
 The fit, robust over 150 cycles:
 
@@ -184,6 +187,7 @@ class _Spec:
     names: list
     prior_std: float = 0.0  # of the excess coefficient; 0: not fitted
     noise: float = 1.0  # residual scale for the prior row
+    law_sigma: float = 0.0  # relative std of the law's coefficient (model error of a series law)
 
     def index(self, name: str) -> int:
         return self.names.index(name)
@@ -294,14 +298,14 @@ def _start(tau, y, kind, law, omega_mean, excess_prior):
     if kind == "proportional" and law.kind != "linear":
         names.append("gain")  # rad^2 per signal unit^2: the square of the unknown scale
         p.append(0.0)
-    elif law.kind != "linear":
+    elif law.kind == "exact":
         prior = excess_prior * abs(law.coefficient(omega))
         if prior > 0.0:
             names.append("excess")
             p.append(0.0)
     step = 2.0 * math.pi / (omega * _STEPS_PER_PERIOD)
     noise = 1.4826 * float(np.median(np.abs(y[first] - np.median(y[first])))) or 1.0
-    return _Spec(kind, law, tau, y, step, names, prior, noise), np.array(p)
+    return _Spec(kind, law, tau, y, step, names, prior, noise, excess_prior), np.array(p)
 
 
 def _residual(spec: _Spec, p: np.ndarray, mask: np.ndarray) -> np.ndarray:
@@ -382,6 +386,12 @@ def _result(spec: _Spec, p: np.ndarray, kept: np.ndarray, t: np.ndarray, y: np.n
         raise ValueError(f"no oscillation stands out of the noise (fitted swing / residual RMS = {snr:.2g} "
                          f"< {MIN_SNR:g})")
     cov, cov_white, block = _covariance(spec, p, kept, r)
+    amplitude = _amplitudes(spec, p)
+    if spec.law.kind == "series" and spec.kind != "proportional" and amplitude is not None:
+        # model error: the series law is not fitted (over a coupled mode the waveform's harmonics would
+        # set it wrongly); its coefficient's uncertainty moves omega by law_sigma s <A^2>
+        mean_a2 = 0.5 * (amplitude[0] ** 2 + amplitude[1] ** 2)
+        cov[0, 0] += (p[0] * spec.law_sigma * abs(spec.law.s) * mean_a2) ** 2
     std = np.sqrt(np.diag(cov))
     omega = p[0]
     n = spec.names
@@ -397,7 +407,7 @@ def _result(spec: _Spec, p: np.ndarray, kept: np.ndarray, t: np.ndarray, y: np.n
         zeta=p[1], zeta_std=std[1], quadratic=p[2], quadratic_std=std[2],
         amplitude_coefficient=spec.law.coefficient(omega) + excess, amplitude_coefficient_std=excess_std,
         law=spec.law.kind if spec.kind != "proportional" or spec.law.kind == "linear" else "series (scale fitted)",
-        amplitude=_amplitudes(spec, p),
+        amplitude=amplitude,
         offset=p[5], drift=p[6], rms=rms,
         outliers=t[~kept], second_mode=second, block=block,
         names=tuple(n), parameters=p, covariance=cov, samples=int(kept.sum()),
