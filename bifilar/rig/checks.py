@@ -134,17 +134,38 @@ def vector3(value, source: str, name: str) -> np.ndarray:
     return np.array([number(v, source, f"{name}[{i}]") for i, v in enumerate(value)])
 
 
-def inertia_tensor(value, source: str) -> np.ndarray:
+def inertia_tensor(value, source: str, free: int | None = None) -> np.ndarray:
+    """The 3x3 tensor of ``body.inertia`` (three principal moments or a symmetric matrix), checked
+    positive definite and for the triangle inequality of its principal moments.
+
+    ``free`` (0, 1, 2): the diagonal entry that is being identified. It may be ``nan`` (unknown) or
+    any positive value (a starting point only); the checks then apply to the rest of the tensor,
+    and the identified tensor is checked by the caller once the entry is known.
+    """
     name = "body.inertia"
+    entry = (lambda v, n: _free_number(v, source, n)) if free is not None else (lambda v, n: number(v, source, n))
     if isinstance(value, list) and len(value) == 3 and all(isinstance(r, list) for r in value):
-        rows = [vector3(r, source, f"{name}[{i}]") for i, r in enumerate(value)]
+        rows = []
+        for i, r in enumerate(value):
+            if not isinstance(r, list) or len(r) != 3:
+                raise RigError(source, f"{name}[{i}]", "must be a list of three numbers")
+            rows.append([entry(v, f"{name}[{i}][{k}]") if (i, k) == (free, free) else number(v, source, f"{name}[{i}][{k}]")
+                         for k, v in enumerate(r)])
         tensor = np.array(rows)
-        if not np.allclose(tensor, tensor.T, rtol=1e-12, atol=1e-12 * np.abs(tensor).max()):
+        known = np.where(np.isnan(tensor), 0.0, tensor)
+        if not np.allclose(known, known.T, rtol=1e-12, atol=1e-12 * np.abs(known).max()):
             raise RigError(source, name, "is not symmetric")
     elif isinstance(value, list) and len(value) == 3:
-        tensor = np.diag(vector3(value, source, name))
+        tensor = np.diag([entry(v, f"{name}[{i}]") if i == free else number(v, source, f"{name}[{i}]")
+                          for i, v in enumerate(value)])
     else:
         raise RigError(source, name, "must be three principal moments or a symmetric 3x3 matrix")
+    if free is not None:
+        rest = [i for i in range(3) if i != free]
+        sub = tensor[np.ix_(rest, rest)]
+        if np.linalg.eigvalsh(sub)[0] <= 0.0:
+            raise RigError(source, name, "the entries other than the identified moment are not positive definite")
+        return 0.5 * (tensor + tensor.T)
     moments = np.linalg.eigvalsh(tensor)
     if moments[0] <= 0.0:
         raise RigError(source, name, f"is not positive definite (eigenvalues {fmt_values(moments)})")
@@ -154,6 +175,13 @@ def inertia_tensor(value, source: str) -> np.ndarray:
             source, name, f"breaks the triangle inequality I1 + I2 >= I3 (principal moments {fmt_values(moments)})"
         )
     return 0.5 * (tensor + tensor.T)
+
+
+def _free_number(value, source: str, name: str) -> float:
+    """The identified moment: nan (unknown) or a positive start value."""
+    if isinstance(value, float) and math.isnan(value):
+        return value
+    return positive(value, source, name)
 
 
 def fmt_values(values) -> str:

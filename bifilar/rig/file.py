@@ -85,14 +85,21 @@ _INITIAL_KEYS = {"rotation", "omega"}
 _UNCERTAINTY_KEYS = set(Uncertainty.__dataclass_fields__)
 
 
-def load_rig(path: str | Path) -> Rig:
-    """Read and check a rig file; raise :class:`RigError` on any problem."""
+def load_rig(path: str | Path, free_moment: int | None = None) -> Rig:
+    """Read and check a rig file; raise :class:`RigError` on any problem.
+
+    ``free_moment`` (0, 1, 2): the diagonal inertia entry being identified, which may be ``nan`` or
+    any positive start value (:func:`bifilar.rig.checks.inertia_tensor`); a ``nan`` stays in the
+    returned tensor for the caller to fill.
+    """
     data = read_toml(path)
-    return rig_from_dict(data, source=str(path), default_name=re.sub(r"[^A-Za-z0-9_.-]", "_", Path(path).stem))
+    return rig_from_dict(data, source=str(path), default_name=re.sub(r"[^A-Za-z0-9_.-]", "_", Path(path).stem),
+                         free_moment=free_moment)
 
 
-def rig_from_dict(data: dict, source: str = "<memory>", default_name: str = "rig") -> Rig:
-    """Build a checked :class:`Rig` from the parsed TOML table (see the module docstring)."""
+def rig_from_dict(data: dict, source: str = "<memory>", default_name: str = "rig", free_moment: int | None = None) -> Rig:
+    """Build a checked :class:`Rig` from the parsed TOML table (see the module docstring and
+    :func:`load_rig` for ``free_moment``)."""
     no_unknown(data, _TOP_KEYS, source, "")
     name = data.get("name", default_name)
     if not isinstance(name, str) or not re.fullmatch(r"[A-Za-z0-9_.-]+", name) or name.startswith("."):
@@ -103,7 +110,7 @@ def rig_from_dict(data: dict, source: str = "<memory>", default_name: str = "rig
     no_unknown(body, _BODY_KEYS, source, "body.")
     mass = positive(required(body, "mass", source, "body."), source, "body.mass")
     com = vector3(body.get("com", [0.0, 0.0, 0.0]), source, "body.com")
-    inertia = inertia_tensor(required(body, "inertia", source, "body."), source)
+    inertia = inertia_tensor(required(body, "inertia", source, "body."), source, free_moment)
 
     wires_raw = data.get("wire")
     if not isinstance(wires_raw, list) or not all(isinstance(w, dict) for w in wires_raw):
