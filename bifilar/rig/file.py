@@ -152,7 +152,7 @@ def rig_from_dict(data: dict, source: str = "<memory>", default_name: str = "rig
         uncertainty=unc,
         source=source,
     )
-    check_ranges(rig)
+    check_ranges(rig, free_moment)
     check_reachable(rig)
     return rig
 

@@ -45,9 +45,11 @@ def rig_size(wires) -> float:
                      np.linalg.norm(attach[0] - attach[-1])))
 
 
-def check_ranges(rig) -> None:
+def check_ranges(rig, free_moment: int | None = None) -> None:
     """Raise :class:`RigError` for the first field of ``rig`` (a :class:`bifilar.rig.Rig`) outside its
-    range; the order is the file's (gravity, body, wires, initial, uncertainty)."""
+    range; the order is the file's (gravity, body, wires, initial, uncertainty). ``free_moment``: the
+    diagonal inertia entry being identified (its value is unknown or a guess): only the others are
+    held to the inertia range."""
     src = rig.source
     low, high, unit, why = RANGES["gravity"]
     within(rig.gravity, low, high, src, "gravity", unit, why)
@@ -71,7 +73,8 @@ def check_ranges(rig) -> None:
     offset = min(float(np.linalg.norm(rig.com - w.attach)) for w in rig.wires)
     within(offset, 0.0, MAX_COM_OFFSET * size, src, "body.com", "m",
            f"its distance from the nearest attachment, at most {MAX_COM_OFFSET:g} x the rig's size {size:.3g} m")
-    moments = np.linalg.eigvalsh(rig.inertia)
+    known = [i for i in range(3) if i != free_moment]
+    moments = np.linalg.eigvalsh(rig.inertia[np.ix_(known, known)])
     scale = rig.mass * size**2
     if moments[0] < MIN_INERTIA * scale or moments[-1] > MAX_INERTIA * scale:
         raise RigError(src, "body.inertia", f"principal moments {_fmt(moments)} kg m^2 outside {MIN_INERTIA:g} .. "
