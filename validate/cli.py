@@ -21,6 +21,7 @@ from bifilar.rig import RigError, load_rig
 from .argtypes import OneLineParser, UsageError, bounded_float, positive_float, whole_number
 from .commands import boat as boat_cli
 from .commands import identify as identify_cli
+from .commands import sweep as sweep_cli
 
 OK, CHECK_FAILED, BAD_INPUT, WENT_SLACK, RUN_FAILED, INTERRUPTED, BROKEN_PIPE = 0, 1, 2, 3, 4, 130, 141
 
@@ -101,6 +102,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     identify_cli.add_parser(sub)
     boat_cli.add_parser(sub)
+    sweep_cli.add_parser(sub)
     return parser
 
 
@@ -229,7 +231,7 @@ def _check_outputs(args) -> None:
         value = getattr(args, name, None)
         if not isinstance(value, str):
             continue
-        folder = (name == "rerun" and args.command == "all") or (name == "out" and args.command == "mjcf")
+        folder = (name == "rerun" and args.command == "all") or (name == "out" and args.command in ("mjcf", "sweep"))
         check_writable(Path(value) / "probe" if folder else value)
 
 
@@ -408,4 +410,5 @@ _COMMANDS = {
     "mjcf": _cmd_mjcf,
     "identify": identify_cli.run,
     "boat": boat_cli.run,
+    "sweep": sweep_cli.run,
 }

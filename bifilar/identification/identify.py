@@ -124,10 +124,10 @@ class Pencil:
         return int(np.argmax(self.shares(value, v))), w2, v
 
 
-def pencil(rig: Rig, axis, rest: Rest | None = None) -> Pencil:
-    """Linearise the rig once (about ``rest``, default its computed rest pose) for any moment about
-    ``axis``."""
-    lin = linearize(rig, rest)
+def pencil(rig: Rig, axis, rest: Rest | None = None, lin: Modes | None = None) -> Pencil:
+    """Linearise the rig once (about ``rest``, default its computed rest pose; or take ``lin``, its
+    linearisation, if known) for any moment about ``axis``."""
+    lin = linearize(rig, rest) if lin is None else lin
     e = axis_vector(axis)
     j0 = moment(rig, e)
     floor = j0 - 1.0 / float(e @ np.linalg.solve(rig.inertia, e))
@@ -210,6 +210,15 @@ def invert_period(rig: Rig, axis, period: float, rest: Rest | None = None, p: Pe
     value, k, w2, v = next(iter(found.values()))
     sensitivity = float(0.5 * p.shares(value, v[:, k:k + 1])[0])
     return Identified(float(value), float(2.0 * np.pi / np.sqrt(w2[k])), sensitivity, with_moment(rig, p.axis, value))
+
+
+def predicted(rig: Rig, p: Pencil) -> Identified:
+    """The inversion of the period the rig itself predicts for the mode associated with the axis:
+    its root is the rig's own moment J0 by construction (what a sweep asks: how well would this rig
+    measure its own moment), so no mode needs following to it."""
+    k, w2, v = p.associated(p.moment0)
+    sensitivity = float(0.5 * p.shares(p.moment0, v[:, k:k + 1])[0])
+    return Identified(p.moment0, float(2.0 * np.pi / np.sqrt(w2[k])), sensitivity, rig)
 
 
 def linear_period(rig: Rig, axis, rest: Rest | None = None) -> float:

@@ -12,9 +12,14 @@ standard deviations of :class:`bifilar.rig.Uncertainty`, one per group:
 The other entries of the inertia tensor and gravity are taken as exact.
 
 Linear (:func:`linear`): the Jacobian of the exact inversion (:func:`bifilar.identify.invert_period`)
-by forward differences, with steps of 1e-3 sigma per input: small against the scale on which the
-inversion curves, large against its ~1e-12 relative rounding. var J = sum_i (dJ/dx_i sigma_i)^2, the
-95 % interval J +- 1.96 sigma, and the budget gives each group's share of the variance.
+by the implicit function theorem. The identified J solves ln T_k(J, x) = ln T_measured, so
+dJ/dx_i = -(d ln T/dx_i) / (d ln T/dJ): d ln T/dJ = s / J with s the inversion's sensitivity
+(Hellmann-Feynman, exact), and d ln T/dx_i, the change of the associated mode's period at fixed J, by
+forward differences with steps of 1e-3 sigma per input (small against the scale on which the period
+curves, large against its ~1e-13 rounding); the period's own entry is dJ/dT = J / (s T). Each
+perturbed rig's rest pose is continued from the base pose by Newton's method and linearised once for
+every axis (:func:`linear_axes`). var J = sum_i (dJ/dx_i sigma_i)^2, the 95 % interval J +- 1.96 sigma,
+and the budget gives each group's share of the variance.
 
 Monte Carlo (:func:`monte_carlo`): the inputs drawn around their measured values and each draw
 inverted; the standard deviation and the 2.5 / 97.5 % quantiles of the draws, and a budget from the
@@ -32,7 +37,9 @@ import numpy as np
 from scipy.stats import norm
 
 from bifilar.identification.identify import invert_period, linear_period, moment, pencil
+from bifilar.motion.modes import linearize
 from bifilar.rig import Rig, Uncertainty, Wire
+from bifilar.rig.statics import Rest, rest_pose
 
 GROUPS = tuple(f.name for f in fields(Uncertainty))
 LEVEL = 0.95
@@ -109,22 +116,42 @@ def _budget(inp: Inputs, gradient: np.ndarray) -> dict[str, float]:
     return {g: float(parts[groups == g].sum() / total) if total > 0.0 else 0.0 for g in GROUPS}
 
 
-def linear(rig: Rig, axis, period: float, period_std: float) -> Propagation:
-    """First-order propagation through the exact inversion (see the module docstring)."""
-    base = invert_period(rig, axis, period)
-    inp = inputs(base.rig, period, period_std)
-    gradient = np.zeros(len(inp.values))
-    own = pencil(base.rig, axis)  # the period alone does not move the rest pose: linearise once
-    for i in np.flatnonzero(inp.std > 0.0):
+def linear(rig: Rig, axis, period: float, period_std: float, rest: Rest | None = None) -> Propagation:
+    """First-order propagation through the exact inversion (see the module docstring); ``rest``: the
+    rig's rest pose if known."""
+    return linear_axes(rig, {axis: period}, period_std, rest)[axis]
+
+
+def linear_axes(rig: Rig, periods: dict, period_std: float, rest: Rest | None = None, bases: dict | None = None) -> dict:
+    """:func:`linear` for several axes at once (axis -> measured period): the perturbed rigs' rest
+    poses and linearisations are shared, as the geometry inputs are the same for every axis.
+    ``bases``: the inversions (axis -> :class:`Identified`) if already known."""
+    rest = rest_pose(rig) if rest is None else rest
+    if bases is None:
+        bases = {a: invert_period(rig, a, t, rest) for a, t in periods.items()}
+    inp = inputs(rig, 0.0, period_std)
+    slopes = {a: np.zeros(len(inp.values)) for a in periods}  # d ln T / d x_i at fixed J
+    for i in np.flatnonzero(inp.std[:-1] > 0.0):
         x = inp.values.copy()
         h = _STEP * inp.std[i]
         x[i] += h
-        changed, t = apply(base.rig, x)
-        p = own if inp.groups[i] == "period" else None
-        gradient[i] = (invert_period(changed, axis, t, p=p).moment - base.moment) / h
-    std = float(np.sqrt(np.sum((gradient * inp.std) ** 2)))
-    return Propagation(base.moment, std, base.moment - _Z * std, base.moment + _Z * std, "linear",
-                       _budget(inp, gradient), inp, gradient)
+        changed, _ = apply(rig, x)
+        lin = linearize(changed, rest_pose(changed, guess=rest))
+        for a, b in bases.items():
+            p = pencil(changed, a, lin=lin)
+            k, w2, _ = p.associated(b.moment)
+            slopes[a][i] = (np.log(2.0 * np.pi / np.sqrt(w2[k])) - np.log(b.period)) / h
+    out = {}
+    for a, b in bases.items():
+        dlnT_dJ = b.sensitivity / b.moment
+        gradient = -slopes[a] / dlnT_dJ
+        gradient[-1] = 1.0 / (b.period * dlnT_dJ)  # dJ / dT of the measured period
+        own = inputs(b.rig, periods[a], period_std)
+        gradient = np.where(own.std > 0.0, gradient, 0.0)
+        std = float(np.sqrt(np.sum((gradient * own.std) ** 2)))
+        out[a] = Propagation(b.moment, std, b.moment - _Z * std, b.moment + _Z * std, "linear",
+                             _budget(own, gradient), own, gradient)
+    return out
 
 
 def monte_carlo(rig: Rig, axis, period: float, period_std: float, samples: int, rng: np.random.Generator) -> Propagation:

@@ -134,7 +134,9 @@ def newton_equilibrium(com, rot, tensions, arms, anchors, lengths, weight, scale
         if not np.isfinite(err) or err > 1e6 * min(best, 1.0) + 1.0:
             break
         best = min(best, err)
-        step = np.linalg.solve(jac, -res)
+        # Least squares: the minimum-norm step where the Jacobian is singular (a neutral tilt
+        # about the line of two attachments), Newton's step elsewhere.
+        step = np.linalg.lstsq(jac, -res, 1e-13)[0]
         if not np.all(np.isfinite(step)):
             break
         # Limit the turn and the shift per step: Newton far from the solution may jump to the

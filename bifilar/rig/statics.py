@@ -117,7 +117,9 @@ def rest_pose(rig: Rig, guess: Rest | None = None) -> Rest:
     if guess is not None:
         rest = _polish(rig, guess.com, guess.rotation, guess.tensions)
         if rest is not None and _stable(rig, rest):
-            return rest
+            # A neutral tilt (COM on the attachment line) leaves Newton anywhere along it: the same
+            # representative as without a guess.
+            return Rest(rest.com, _nearest_on_neutral_axis(rig, rest.com, rest.rotation), rest.tensions)
     return _global_rest_pose(rig)
 
 

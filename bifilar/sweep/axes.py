@@ -1,0 +1,91 @@
+"""The axes a sweep file may vary, each a function (rig, value) -> rig, applied exactly as documented.
+
+World frame z up. "Span" axes move the two points of a pair symmetrically about their midpoint along
+the line that joins them (the pair: the two anchors, or the two attachments, of wires 1 and 2), so the
+midpoint and the direction are the base rig's; "height" axes move along world z (anchors) or body z
+(attachments). Every axis acts on wires 1 and 2, the pair that defines a bifilar rig.
+
+- ``wire_length``: both wires' lengths (m).
+- ``wire_length_2``: wire 2's length alone (m), for unequal wires; applied after ``wire_length``.
+- ``anchor_span``: the distance between the two ceiling anchors (m).
+- ``attach_span``: the distance between the two attachments (m), in the body frame.
+- ``attach_height``: both attachments' body-frame z (m).
+- ``anchor_height_difference``: anchor 2's world z minus anchor 1's (m), about their mean height.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+
+from bifilar.rig import Rig
+
+
+def _wires(rig: Rig, **changes) -> Rig:
+    wires = list(rig.wires)
+    for index, fields in changes.items():
+        i = int(index[1:])
+        wires[i] = replace(wires[i], **fields)
+    return replace(rig, wires=tuple(wires))
+
+
+def _span(a: np.ndarray, b: np.ndarray, span: float) -> tuple[np.ndarray, np.ndarray]:
+    """The pair moved symmetrically about its midpoint to distance ``span``."""
+    mid, half = 0.5 * (a + b), 0.5 * (b - a)
+    direction = half / np.linalg.norm(half)
+    return mid - 0.5 * span * direction, mid + 0.5 * span * direction
+
+
+def wire_length(rig: Rig, value: float) -> Rig:
+    return _wires(rig, w0={"length": value}, w1={"length": value})
+
+
+def wire_length_2(rig: Rig, value: float) -> Rig:
+    return _wires(rig, w1={"length": value})
+
+
+def anchor_span(rig: Rig, value: float) -> Rig:
+    a, b = _span(rig.wires[0].anchor, rig.wires[1].anchor, value)
+    return _wires(rig, w0={"anchor": a}, w1={"anchor": b})
+
+
+def attach_span(rig: Rig, value: float) -> Rig:
+    a, b = _span(rig.wires[0].attach, rig.wires[1].attach, value)
+    return _wires(rig, w0={"attach": a}, w1={"attach": b})
+
+
+def attach_height(rig: Rig, value: float) -> Rig:
+    a, b = rig.wires[0].attach.copy(), rig.wires[1].attach.copy()
+    a[2] = b[2] = value
+    return _wires(rig, w0={"attach": a}, w1={"attach": b})
+
+
+def anchor_height_difference(rig: Rig, value: float) -> Rig:
+    a, b = rig.wires[0].anchor.copy(), rig.wires[1].anchor.copy()
+    mean = 0.5 * (a[2] + b[2])
+    a[2], b[2] = mean - 0.5 * value, mean + 0.5 * value
+    return _wires(rig, w0={"anchor": a}, w1={"anchor": b})
+
+
+# Application order: lengths first so that wire_length_2 overrides wire 2's share of wire_length.
+AXES = {
+    "wire_length": wire_length,
+    "wire_length_2": wire_length_2,
+    "anchor_span": anchor_span,
+    "attach_span": attach_span,
+    "attach_height": attach_height,
+    "anchor_height_difference": anchor_height_difference,
+}
+# Axes whose values are distances that must be positive.
+POSITIVE = {"wire_length", "wire_length_2", "anchor_span", "attach_span"}
+
+
+def configure(rig: Rig, values: dict[str, float]) -> Rig:
+    """The base rig with every axis in ``values`` applied, in :data:`AXES` order."""
+    for name, apply in AXES.items():
+        if name in values:
+            rig = apply(rig, float(values[name]))
+    return rig
+
+

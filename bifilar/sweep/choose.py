@@ -1,0 +1,40 @@
+"""Choosing among the configurations: the objective, the best feasible row and the Pareto front.
+
+Objective (the sweep file's ``measure.objective``): ``worst``, the largest relative standard deviation
+of the moments in ``measure.axes`` (a rig is as good as its worst-measured moment; the default), or
+``mean``, their mean. Only feasible rows (every limit held, every measured axis identifiable) count.
+The Pareto front trades the objective against the peak tension: a feasible row is on it when no other
+feasible row is at least as good in both and better in one.
+"""
+
+from __future__ import annotations
+
+import math
+
+
+def objective(row: dict, measured, kind: str) -> float:
+    values = [row["sigma"][a] for a in measured]
+    if not row["feasible"] or any(v is None for v in values):
+        return math.inf
+    return max(values) if kind == "worst" else sum(values) / len(values)
+
+
+def best(rows: list[dict], measured, kind: str) -> dict | None:
+    """The feasible row of least objective (the first in grid order on a tie), or None."""
+    scored = [(objective(r, measured, kind), i) for i, r in enumerate(rows)]
+    value, i = min(scored, default=(math.inf, -1))
+    return rows[i] if math.isfinite(value) else None
+
+
+def pareto(rows: list[dict], measured, kind: str) -> list[dict]:
+    """Feasible rows not dominated in (objective, peak tension), by increasing objective."""
+    points = sorted(
+        ((objective(r, measured, kind), r["tension_peak"], i) for i, r in enumerate(rows)
+         if math.isfinite(objective(r, measured, kind))),
+    )
+    front, lowest = [], math.inf
+    for value, tension, i in points:
+        if tension < lowest:
+            front.append(rows[i])
+            lowest = tension
+    return front

@@ -1,0 +1,169 @@
+"""One configuration of a sweep: rest pose, modes, identification uncertainty, tensions, clearance.
+
+Everything goes through the project's one code path: the rest pose of :mod:`bifilar.rig.statics`
+(continued from the neighbouring configuration's), the modes of :mod:`bifilar.motion.modes`, the mode
+associated with each measured axis and the linear propagation of the rig's ``[uncertainty]`` through
+the exact inversion that ``identify`` uses (:func:`bifilar.identification.propagation.linear`).
+
+Peak tension in a measured motion of amplitude A (the peak rotation about the axis, rad). The wire
+tensions of a state follow exactly from Newton-Euler with the wires as constraints (pose coordinates
+q = (x, theta) of :mod:`bifilar.rig.pose_kernel`): with J the constraint Jacobian, M = diag(m I, I_w),
+F the weight and the gyroscopic wrench, differentiating J q' = 0 gives
+
+    t = (J M^-1 J^T)^-1 (J M^-1 (F - gyro) + h),   h_i = q'^T (hess g_i) q',
+
+the generalised force of wire i being -t_i grad g_i. In the linear mode the state passes the rest pose
+with the peak velocity (there h, the centripetal part, is largest) and turns at the displaced poses
++-A shape with no velocity (there the first-order part is largest); the peak tension is the largest
+over these three states: exact at the bottom, first order at the turning points. The test checks it
+against the Kane model's simulated tensions.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from bifilar.bodies.composite import equivalent_box
+from bifilar.identification import identify as ident
+from bifilar.identification.propagation import linear_axes
+from bifilar.motion.modes import Modes, linearize
+from bifilar.rig import Rig, RigError
+from bifilar.rig import pose_kernel as PK
+from bifilar.rig.file import check_reachable
+from bifilar.rig.statics import Rest, anchors, arms, rest_pose
+from bifilar.sweep.axes import configure
+from bifilar.sweep.space import Space
+
+AXES = ("x", "y", "z")
+
+
+@dataclass
+class Row:
+    """The results for one configuration (SI; relative sigma is std / moment)."""
+
+    values: dict[str, float]
+    feasible: bool = False
+    reason: str = ""
+    periods: tuple = (None, None, None, None)  # s, longest first; None for neutral / absent
+    motions: tuple = ("", "", "", "")
+    tensions: tuple = (math.nan, math.nan)  # N at rest, wires 1 and 2
+    tension_peak: float = math.nan  # N
+    sigma: dict | None = None  # axis -> relative sigma (None: not identifiable or not measured)
+    dominant: dict | None = None  # axis -> the uncertainty group with the largest share
+    separation: float = math.nan  # smallest relative gap between two mode periods
+    clearance: float = math.nan  # m above the floor (minus nothing: the margin is a limit)
+    rest: Rest | None = None
+
+    def objective(self, kind: str) -> float:
+        vals = [v for v in (self.sigma or {}).values() if v is not None]
+        if not self.feasible or not vals:
+            return math.inf
+        return max(vals) if kind == "worst" else float(np.mean(vals))
+
+
+def state_tensions(rig: Rig, com, rotation, velocity) -> np.ndarray:
+    """Wire tensions (N) of the state (pose, velocity q' = (COM velocity, omega), world)."""
+    s, u, rho = PK.wire_geometry(np.asarray(com, float), np.asarray(rotation, float), arms(rig), anchors(rig))
+    jac = PK.constraint_jacobian(s, u)
+    inertia = rotation @ rig.inertia @ rotation.T
+    minv = np.zeros((6, 6))
+    minv[:3, :3] = np.eye(3) / rig.mass
+    minv[3:, 3:] = np.linalg.inv(inertia)
+    omega = velocity[3:]
+    force = np.concatenate([[0.0, 0.0, -rig.mass * rig.gravity], -np.cross(omega, inertia @ omega)])
+    h = np.array([velocity @ PK.constraint_hessian(s, u, rho, i) @ velocity for i in range(len(rig.wires))])
+    return np.linalg.solve(jac @ minv @ jac.T, jac @ minv @ force + h)
+
+
+def peak_tension(rig: Rig, lin: Modes, index: int, amplitude_about: np.ndarray, amplitude: float) -> float:
+    """Largest wire tension (N) over the motion of mode ``index`` whose peak rotation about the world
+    axis ``amplitude_about`` is ``amplitude`` (see the module docstring)."""
+    mode = lin.modes[index]
+    turn = abs(mode.rotation @ amplitude_about)
+    if mode.period is None or turn <= 0.0:
+        return math.nan
+    shape = np.concatenate([mode.com, mode.rotation]) * (amplitude / turn)
+    rest = lin.rest
+    peak = state_tensions(rig, rest.com, rest.rotation, shape * (2.0 * np.pi / mode.period)).max()
+    for sign in (1.0, -1.0):
+        com = rest.com + sign * shape[:3]
+        rot = PK.rotation_vector_matrix(sign * shape[3:]) @ rest.rotation
+        peak = max(peak, state_tensions(rig, com, rot, np.zeros(6)).max())
+    return float(peak)
+
+
+def measured_mode(rig: Rig, lin: Modes, about: np.ndarray) -> int:
+    """Index in ``lin.modes`` of the oscillating mode with the largest share of its kinetic energy in
+    the rotation about the world axis ``about`` (the mode timed to measure that moment)."""
+    inertia = lin.rest.rotation @ rig.inertia @ lin.rest.rotation.T
+    moment = about @ inertia @ about
+
+    def share(mode):
+        if mode.period is None:
+            return -1.0
+        total = rig.mass * mode.com @ mode.com + mode.rotation @ inertia @ mode.rotation
+        return moment * (mode.rotation @ about) ** 2 / total
+
+    return max(range(len(lin.modes)), key=lambda i: share(lin.modes[i]))
+
+
+def lowest_point(rig: Rig, rest: Rest) -> float:
+    """World z (m) of the lowest corner of the body's inertia-equivalent box at rest."""
+    half, axes = equivalent_box(rig.mass, rig.inertia)
+    corners = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)]) * half
+    body = rig.com + corners @ axes.T
+    world = rest.com + (body - rig.com) @ rest.rotation.T
+    return float(world[:, 2].min())
+
+
+def evaluate(space: Space, values: dict[str, float], guess: Rest | None = None) -> Row:
+    """Evaluate one configuration; an unreachable one is a row marked infeasible, never an error."""
+    row = Row(values=values)
+    try:
+        rig = configure(space.rig, values)
+        check_reachable(rig)
+        rest = rest_pose(rig, guess)
+        lin = linearize(rig, rest)
+    except (RigError, np.linalg.LinAlgError) as exc:
+        row.reason = exc.problem if isinstance(exc, RigError) else f"singular: {exc}"
+        return row
+    row.rest = rest
+    row.tensions = tuple(float(t) for t in rest.tensions[:2])
+    periods = [m.period for m in lin.modes] + [None] * 4
+    row.periods = tuple(periods[:4])
+    row.motions = tuple(([m.motion for m in lin.modes] + [""] * 4)[:4])
+    osc = sorted(p for p in row.periods if p is not None)
+    row.separation = min((b - a) / b for a, b in zip(osc, osc[1:])) if len(osc) > 1 else math.nan
+    row.sigma, row.dominant = {}, {}
+    peaks = [float(rest.tensions.max())]
+    bases = {}
+    for axis in space.measure:
+        p = ident.pencil(rig, axis, lin=lin)
+        if p.shares(p.moment0, p.modes(p.moment0)[1]).max() < 1e-12:  # no mode turns about the axis
+            row.sigma[axis], row.dominant[axis] = None, None
+            continue
+        bases[axis] = ident.predicted(rig, p)
+    periods = {axis: b.period for axis, b in bases.items()}
+    spreads = linear_axes(rig, periods, rig.uncertainty.period, rest, bases)
+    for axis, spread in spreads.items():
+        row.sigma[axis] = spread.std / spread.moment
+        row.dominant[axis] = max(spread.budget, key=spread.budget.get) if spread.std > 0.0 else None
+        about = rest.rotation @ ident.axis_vector(axis)
+        peaks.append(peak_tension(rig, lin, measured_mode(rig, lin, about), about, space.amplitude))
+    row.tension_peak = float(np.nanmax(peaks))
+    limits = space.limits
+    if limits.floor is not None:
+        row.clearance = lowest_point(rig, rest) - limits.floor
+    problems = []
+    if any(v is None for v in row.sigma.values()):
+        problems.append("an axis cannot be identified")
+    if limits.tension is not None and row.tension_peak > limits.tension:
+        problems.append(f"peak tension {row.tension_peak:.6g} N over {limits.tension:g} N")
+    if limits.floor is not None and row.clearance < limits.clearance:
+        problems.append(f"clearance {row.clearance:.4g} m under {limits.clearance:g} m")
+    row.feasible = not problems
+    row.reason = "; ".join(problems)
+    return row

@@ -1,0 +1,123 @@
+"""Run a sweep in chunks: on local processes or a Dask cluster, resumable, results bit for bit alike.
+
+The grid is cut into chunks of consecutive configurations (grid order, the last axis fastest, so that
+neighbours follow each other and each rest pose continues from the previous one's). A chunk is a pure
+function of the sweep file and its index range, so any executor gives identical rows. Each finished
+chunk is saved whole (temp + rename) under ``DIR/.chunks/``; a restarted sweep with the same ``--out``
+reuses the saved chunks of the same sweep file (checked by a digest of its contents) and runs the rest.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+import os
+import tempfile
+from concurrent.futures import ProcessPoolExecutor
+from pathlib import Path
+
+from threadpoolctl import threadpool_limits
+
+from bifilar.rig.statics import Rest
+from bifilar.sweep.evaluate import AXES, Row, evaluate
+from bifilar.sweep.space import Space, load_space
+
+CHUNK = 64  # configurations per chunk: long enough for continuation, short enough to balance cores
+
+
+def _plain(row: Row) -> dict:
+    """A row as JSON-safe values (None for missing numbers)."""
+    def num(x):
+        return None if x is None or (isinstance(x, float) and not math.isfinite(x)) else float(x)
+
+    return {
+        "values": row.values, "feasible": row.feasible, "reason": row.reason,
+        "periods": [num(p) for p in row.periods], "motions": list(row.motions),
+        "tensions": [num(t) for t in row.tensions], "tension_peak": num(row.tension_peak),
+        "sigma": {a: num((row.sigma or {}).get(a)) for a in AXES},
+        "dominant": {a: (row.dominant or {}).get(a) for a in AXES},
+        "separation": num(row.separation), "clearance": num(row.clearance),
+    }
+
+
+def run_chunk(path: str, start: int, stop: int) -> list[dict]:
+    """Evaluate configurations ``start`` .. ``stop - 1`` of the sweep file, each rest pose continued
+    from the last one found. BLAS runs on one thread whatever the executor (Dask workers default to
+    one, a local process to all cores): its rounding depends on the thread count, and a near-degenerate
+    eigenproblem turns a last-digit difference into a visible one."""
+    with threadpool_limits(1):
+        return _evaluate_range(path, start, stop)
+
+
+def _evaluate_range(path: str, start: int, stop: int) -> list[dict]:
+    space = load_space(path)
+    guess: Rest | None = None
+    rows = []
+    for index, values in enumerate(space.points()):
+        if index < start:
+            continue
+        if index >= stop:
+            break
+        row = evaluate(space, values, guess)
+        guess = row.rest if row.rest is not None else guess
+        rows.append(_plain(row))
+    return rows
+
+
+def digest(path: str, chunk: int) -> str:
+    """Identifies the sweep (its file, the base rig's file, the chunk size) for resuming."""
+    space = load_space(path)
+    h = hashlib.sha256(Path(path).read_bytes())
+    h.update(Path(space.rig.source).read_bytes())
+    h.update(str(chunk).encode())
+    return h.hexdigest()[:16]
+
+
+def _save(folder: Path, name: str, rows: list[dict]) -> None:
+    fd, tmp = tempfile.mkstemp(dir=folder, suffix=".tmp")
+    with os.fdopen(fd, "w") as f:
+        json.dump(rows, f)
+    os.replace(tmp, folder / name)
+
+
+def run(path: str, space: Space, out: Path, jobs: int = 1, scheduler: str | None = None, progress=None,
+        chunk: int = CHUNK) -> list[dict]:
+    """Every row of the sweep, in grid order. ``progress(n_done)`` is called as chunks finish."""
+    chunks = [(s, min(s + chunk, space.size)) for s in range(0, space.size, chunk)]
+    folder = out / ".chunks" / digest(path, chunk)
+    folder.mkdir(parents=True, exist_ok=True)
+    done: dict[int, list[dict]] = {}
+    for k in range(len(chunks)):
+        f = folder / f"{k:06d}.json"
+        if f.exists():
+            done[k] = json.loads(f.read_text())
+    if progress:
+        progress(sum(len(r) for r in done.values()))
+    todo = [k for k in range(len(chunks)) if k not in done]
+    absolute = str(Path(path).resolve())
+
+    def finish(k, rows):
+        _save(folder, f"{k:06d}.json", rows)
+        done[k] = rows
+        if progress:
+            progress(sum(len(r) for r in done.values()))
+
+    if scheduler:
+        from dask.distributed import Client, as_completed
+
+        with Client(scheduler) as client:
+            futures = {client.submit(run_chunk, absolute, *chunks[k], pure=False): k for k in todo}
+            for fut in as_completed(futures):
+                finish(futures[fut], fut.result())
+    elif jobs > 1 and len(todo) > 1:
+        with ProcessPoolExecutor(max_workers=jobs) as pool:
+            futures = {pool.submit(run_chunk, absolute, *chunks[k]): k for k in todo}
+            from concurrent.futures import as_completed as done_in_order
+
+            for fut in done_in_order(futures):
+                finish(futures[fut], fut.result())
+    else:
+        for k in todo:
+            finish(k, run_chunk(absolute, *chunks[k]))
+    return [row for k in range(len(chunks)) for row in done[k]]

@@ -1,0 +1,174 @@
+"""Sweeps (bifilar/sweep, python -m validate sweep): every CSV field against an independent computation
+for a few rows, the parallel-wire closed form, Dask against local, resuming, bad sweep files."""
+
+import csv
+import json
+import math
+
+import numpy as np
+import pytest
+
+from bifilar.identification import identify as ident
+from bifilar.motion.kane import KaneModel
+from bifilar.motion.modes import linearize
+from bifilar.motion.simulate import simulate
+from bifilar.rig.statics import rest_pose
+from bifilar.sweep import run as sweep_run
+from bifilar.sweep.axes import configure
+from bifilar.sweep.evaluate import evaluate, lowest_point, measured_mode, peak_tension
+from bifilar.sweep.space import load_space
+from validate.cli import main
+
+PARALLEL = """name = "parallel_unc"
+[body]
+mass = 2.0
+inertia = [0.02, 0.05, 0.06]
+[[wire]]
+anchor = [-0.2, 0.0, 1.5]
+attach = [-0.2, 0.0, 0.0]
+length = 1.5
+[[wire]]
+anchor = [0.2, 0.0, 1.5]
+attach = [0.2, 0.0, 0.0]
+length = 1.5
+[uncertainty]
+length = 2e-3
+mass = 1e-2
+period = 3e-3
+"""
+
+
+def _write(tmp_path, space: str, rig: str = PARALLEL):
+    (tmp_path / "rig.toml").write_text(rig)
+    (tmp_path / "space.toml").write_text(space)
+    return tmp_path / "space.toml"
+
+
+def _cli(capsys, *argv):
+    code = main([str(a) for a in argv])
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+def test_parallel_yaw_sigma_matches_the_closed_form_propagation(tmp_path):
+    """(5.2.18) I = m g D^2 T^2 / (16 pi^2 h): with only m, both wire lengths (h = their mean for the
+    torsion of vertical wires: dh = (dL1 + dL2) / 2) and T uncertain, (sigma_I / I)^2 =
+    (sigma_m / m)^2 + (2 sigma_T / T)^2 + (sigma_L / (sqrt 2 h))^2. The sweep's forward differences
+    (step 1e-3 sigma) are good to ~1e-6 relative."""
+    path = _write(tmp_path, 'rig = "rig.toml"\n[vary]\nwire_length = [1.0, 2.5]\n[measure]\naxes = ["z"]\n')
+    space = load_space(path)
+    for values in space.points():
+        row = evaluate(space, values)
+        h, m, D, I = values["wire_length"], 2.0, 0.4, 0.06
+        T = 2 * np.pi * np.sqrt(16 * np.pi**2 * h * I / (m * 9.81 * D**2)) / (2 * np.pi)
+        assert max(p for p in row.periods if p) >= T  # the yaw is one of the modes
+        closed = math.sqrt((1e-2 / m) ** 2 + (2 * 3e-3 / T) ** 2 + (2e-3 / (math.sqrt(2) * h)) ** 2)
+        assert row.sigma["z"] == pytest.approx(closed, rel=1e-5)
+        assert row.tensions == pytest.approx((m * 9.81 / 2, m * 9.81 / 2), rel=1e-12)  # vertical wires
+
+
+def test_every_csv_field_against_an_independent_computation(tmp_path, capsys):
+    path = _write(
+        tmp_path,
+        'rig = "../../models/rigs/bench_plate.toml"\n[vary]\nwire_length = [1.0, 2.0]\nattach_span = [0.3, 0.5]\n'
+        '[limits]\ntension = 20.5\nfloor = 0.5\nclearance = 0.02\n[measure]\naxes = ["x", "z"]\namplitude = 0.05\n',
+        rig="",
+    )
+    (tmp_path / "space.toml").write_text((tmp_path / "space.toml").read_text().replace(
+        "../../models/rigs/bench_plate.toml", str((__import__("pathlib").Path(__file__).parents[1] / "models/rigs/bench_plate.toml").resolve())))
+    code, out, err = _cli(capsys, "sweep", path, "--out", tmp_path / "out", "--jobs", 1)
+    assert code == 0, err
+    assert out.count("\n") == 1 and "4 configurations" in out
+    rows = list(csv.DictReader(open(tmp_path / "out" / "sweep.csv")))
+    assert list(rows[0])[:16] == ["wire_length", "attach_span", "period_1", "period_2", "period_3", "period_4",
+                                  "tension_1", "tension_2", "tension_peak", "sigma_x", "sigma_y", "sigma_z",
+                                  "clearance", "feasible", "motion_1", "motion_2"]
+    space = load_space(path)
+    for row in rows:
+        rig = configure(space.rig, {"wire_length": float(row["wire_length"]), "attach_span": float(row["attach_span"])})
+        # attach_span moves both attachments symmetrically along their line.
+        assert np.linalg.norm(rig.wires[0].attach - rig.wires[1].attach) == pytest.approx(float(row["attach_span"]))
+        rest = rest_pose(rig)  # SLSQP from scratch, not the sweep's continuation
+        lin = linearize(rig, rest)
+        assert [float(row[f"period_{k}"]) for k in range(1, 5)] == pytest.approx([m.period for m in lin.modes], rel=1e-10)
+        assert [float(row["tension_1"]), float(row["tension_2"])] == pytest.approx(rest.tensions, rel=1e-10)
+        assert row["sigma_y"] == ""  # not measured
+        for axis in ("x", "z"):
+            found = ident.invert_period(rig, axis, ident.linear_period(rig, axis, rest), rest)
+            from bifilar.identification.propagation import linear
+
+            spread = linear(rig, axis, found.period, rig.uncertainty.period, rest)
+            assert float(row[f"sigma_{axis}"]) == pytest.approx(spread.std / spread.moment, rel=1e-9)
+        assert float(row["clearance"]) == pytest.approx(lowest_point(rig, rest) - 0.5, abs=1e-12)
+        peak = float(row["tension_peak"])
+        assert peak >= rest.tensions.max()
+        feasible = peak <= 20.5 and float(row["clearance"]) >= 0.02
+        assert row["feasible"] == ("true" if feasible else "false")
+    summary = json.loads((tmp_path / "out" / "summary.json").read_text())
+    assert summary["n"] == 4 and summary["feasible"] == sum(r["feasible"] == "true" for r in rows)
+    if summary["best"]:
+        worst = [max(float(r["sigma_x"]), float(r["sigma_z"])) for r in rows if r["feasible"] == "true"]
+        assert summary["best"]["objective"] == pytest.approx(min(worst), rel=1e-12)
+    assert not (tmp_path / "out" / ".chunks").exists()
+
+
+def test_peak_tension_against_the_kane_model():
+    """The bottom-of-swing tension is exact, the turning points first order: against the Kane model's
+    simulated tensions over two periods of the yaw released at 0.05 rad, the peak's excess over the
+    static tension agrees to 5 % (the neglected second-order turning-point terms)."""
+    from validate.assets import rig as shipped
+
+    rig = shipped("bench_plate")
+    rest = rest_pose(rig)
+    lin = linearize(rig, rest)
+    release = ident.released(rig, "z", 0.05, rest)
+    run = simulate(KaneModel.from_rig(rig), release.state, 2 * release.period, dt_out=release.period / 400)
+    index = measured_mode(rig, lin, release.axis_world)
+    ours = peak_tension(rig, lin, index, release.axis_world, 0.05)
+    kane = run.tension.max()
+    assert (ours - rest.tensions.max()) == pytest.approx(kane - rest.tensions.max(), rel=0.05)
+
+
+def test_dask_cluster_gives_the_local_rows_bit_for_bit_and_a_sweep_resumes(tmp_path):
+    from dask.distributed import Client, LocalCluster
+
+    path = _write(tmp_path, 'rig = "rig.toml"\n[vary]\nwire_length = {from = 1.0, to = 2.0, steps = 3}\n'
+                            'attach_span = [0.3, 0.4]\n[measure]\naxes = ["z"]\n')
+    space = load_space(path)
+    local = sweep_run.run(str(path), space, tmp_path / "a", jobs=1, chunk=2)
+    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1",
+                      dashboard_address=None) as cluster, Client(cluster):
+        remote = sweep_run.run(str(path), space, tmp_path / "b", scheduler=cluster.scheduler_address, chunk=2)
+    assert json.dumps(remote) == json.dumps(local)
+    # Interrupted after the first chunk: a restart reuses it (a changed saved row shows it was read).
+    chunks = tmp_path / "c" / ".chunks" / sweep_run.digest(str(path), 2)
+    chunks.mkdir(parents=True)
+    first = sweep_run.run_chunk(str(path), 0, 2)
+    first[0]["reason"] = "from the saved chunk"
+    (chunks / "000000.json").write_text(json.dumps(first))
+    resumed = sweep_run.run(str(path), space, tmp_path / "c", jobs=1, chunk=2)
+    assert resumed[0]["reason"] == "from the saved chunk" and json.dumps(resumed[1:]) == json.dumps(local[1:])
+
+
+@pytest.mark.parametrize("space, field", [
+    ('rig = "rig.toml"\n[vary]\nwire_lenght = [1.0]\n', "vary.wire_lenght"),
+    ('rig = "rig.toml"\n[vary]\nwire_length = []\n', "vary.wire_length"),
+    ('rig = "rig.toml"\n[vary]\nwire_length = {from = 1.0, to = 1.0, steps = 3}\n', "vary.wire_length"),
+    ('rig = "rig.toml"\n[vary]\nwire_length = {from = 1.0, to = 2.0, steps = 10000}\n'
+     'anchor_span = {from = 1.0, to = 2.0, steps = 10000}\n', "vary"),
+    ('rig = "rig.toml"\n[vary]\nwire_length = [-1.0]\n', "vary.wire_length"),
+    ('rig = "nope.toml"\n[vary]\nwire_length = [1.0]\n', "nope.toml"),
+    ('rig = "rig.toml"\n[vary]\nwire_length = [1.0]\n[measure]\naxes = ["w"]\n', "measure.axes"),
+])
+def test_bad_sweep_files_are_one_line_exit_2(tmp_path, capsys, space, field):
+    path = _write(tmp_path, space)
+    code, out, err = _cli(capsys, "sweep", path, "--out", tmp_path / "out")
+    assert code == 2 and out == "" and err.count("\n") == 1 and field in err, err
+
+
+def test_unreachable_points_inside_a_valid_grid_are_infeasible_rows(tmp_path):
+    """Wires of 0.1 m cannot reach attachments 0.4 m apart from anchors 1.0 m apart: a row, not an error."""
+    path = _write(tmp_path, 'rig = "rig.toml"\n[vary]\nanchor_span = [0.4, 1.0]\nwire_length = [0.1]\n'
+                            '[measure]\naxes = ["z"]\n')
+    rows = sweep_run.run(str(path), load_space(path), tmp_path / "o", jobs=1)
+    assert [r["feasible"] for r in rows] == [True, False] and "no taut pose" in rows[1]["reason"]
