@@ -74,6 +74,19 @@ def test_out_of_range_rig_fields_are_one_line(tmp_path, capsys, edit, field, wor
     assert words in line, line
 
 
+def test_a_wire_that_carries_nothing_at_rest_is_refused_every_time(tmp_path, capsys):
+    """The asymmetric rig with its COM at wire 1's attachment: wire 2 carries ~6e-31 N at rest, taut or
+    slack by the sign of a rounding error (eight runs once exited 2 2 2 2 2 2 0 0); refused, always."""
+    path = tmp_path / "com_at_attach.toml"
+    path.write_text((RIGS / "asymmetric.toml").read_text().replace("com = [0.03, -0.02, -0.08]",
+                                                                    "com = [-0.42, -0.18, 0.1]"))
+    for engine in ("kane", "mujoco"):
+        code, _, err = run_cli(capsys, "simulate", path, "--engine", engine, "--duration", "0.1", "--out",
+                               tmp_path / "x.csv")
+        assert code == 2 and one_error(err).startswith(f"error: {path}: wire[2]: "), err
+        assert "the body hangs from the other wire alone" in err or "slack at rest" in err
+
+
 def test_every_shipped_rig_is_inside_the_ranges():
     for path in sorted(RIGS.glob("*.toml")):
         load_rig(path)  # raises RigError otherwise
