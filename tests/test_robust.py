@@ -384,3 +384,16 @@ def test_numba_cache_is_outside_the_source_tree_and_a_first_compile_is_announced
         announce_compile("test kernels", K.rhs, Fresh)  # once per process
         announce_compile("the cached kernels", K.rhs)
     assert buffer.getvalue().count("\n") == 1 and buffer.getvalue().startswith("note: compiling test kernels with numba")
+
+
+def test_a_kane_csv_that_stops_at_a_slack_wire_ends_with_no_pushing_wire(tmp_path, capsys):
+    """The plate (turned 0.1745 rad) spun at 4 rad/s about x: wire 1 goes slack at 0.0912 s (exit 3). Every row, the last
+    included, has tensions >= 0 (the README: 0 when slack, never pushing); the last row is the last
+    sample before the slack time."""
+    path = tmp_path / "spin.toml"
+    path.write_text(GOOD.replace("omega = [0.0, 0.0, 0.0]", "omega = [4.0, 0.0, 0.0]"))
+    out = tmp_path / "spin.csv"
+    code, _, err = run_cli(capsys, "simulate", path, "--duration", "1", "--out", out)
+    assert code == 3 and one_error(err).startswith(f"error: {path}: wire[1]: went slack at t = 0.0912")
+    table = np.loadtxt(out, delimiter=",", skiprows=1)
+    assert table[-1, 0] == pytest.approx(0.09) and table[:, 8:10].min() >= 0.0
