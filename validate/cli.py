@@ -51,7 +51,8 @@ class RunFailed(Exception):
 
 
 def build_parser() -> argparse.ArgumentParser:
-    parser = OneLineParser(prog="python -m validate", description=__doc__.splitlines()[0], epilog=EPILOG)
+    parser = OneLineParser(prog="python -m validate", description=__doc__.splitlines()[0].replace("``", ""),
+                           epilog=EPILOG)
     sub = parser.add_subparsers(dest="command", required=True, parser_class=OneLineParser, metavar="COMMAND")
 
     p = sub.add_parser("all", help="run every registered validation case", epilog=EPILOG)

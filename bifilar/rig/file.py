@@ -182,10 +182,20 @@ def check_reachable(rig: Rig) -> None:
 
 
 
+MIN_REST_SHARE = 1e-6  # of the weight: a wire carrying less at rest is slack to rounding
+
+
 def check_hanging(rig: Rig, rest) -> None:
     """Raise unless every wire hangs down from its anchor at the rest pose ``rest`` (a
-    :class:`bifilar.rig.statics.Rest`): an anchor below its attachment (the sign of a z flipped) makes a
-    guy wire, not a pendulum, though its tension may well be positive."""
+    :class:`bifilar.rig.statics.Rest`) and carries a share of the weight: an anchor below its
+    attachment (the sign of a z flipped) makes a guy wire, not a pendulum, though its tension may well be
+    positive; a wire that carries ~0 N (the COM straight below the other wire's attachment) is slack or
+    taut by the sign of a rounding error, so a run would be accepted or refused at random."""
+    weight = rig.mass * rig.gravity
+    for i, tension in enumerate(rest.tensions, start=1):
+        if tension < MIN_REST_SHARE * weight:
+            raise RigError(rig.source, f"wire[{i}]", f"carries {tension:.3g} N of the {weight:.6g} N weight at rest "
+                           f"(less than {MIN_REST_SHARE:g} of it): the body hangs from the other wire alone")
     for i, w in enumerate(rig.wires, start=1):
         attach = rest.com + rest.rotation @ (w.attach - rig.com)
         rise = float(w.anchor[2] - attach[2])

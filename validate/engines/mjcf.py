@@ -332,6 +332,9 @@ def xml_main(argv, description: str, input_help: str, write) -> int:
     except OSError as exc:
         print(f"error: {exc.filename}: cannot write ({exc.strerror})", file=sys.stderr)
         return 2
+    except Exception as exc:  # a numerical failure while building: one line, exit 4 (as python -m validate)
+        print(f"error: {args.input}: rig: the model could not be built ({type(exc).__name__}: {exc})", file=sys.stderr)
+        return 4
     for path in paths:
         print(path)
     return 0

@@ -1,0 +1,34 @@
+"""The wheel carries the models: setup.py's package-data globs cover every shipped model file, and CI
+builds, installs and runs the wheel (.ci/wheel: a fresh venv, another folder, the wheel's own code)."""
+
+import fnmatch
+import subprocess
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def test_every_model_file_is_package_data():
+    namespace: dict = {}
+    source = (ROOT / "setup.py").read_text().split("setup(")[0]  # the constants, without building
+    exec(source.replace("from setuptools import find_packages, setup", ""), namespace)
+    globs = namespace["MODEL_FILES"]
+    tracked = subprocess.run(["git", "ls-files", "models"], cwd=ROOT, capture_output=True, text=True).stdout.split()
+    assert tracked, "models/ is not tracked"
+    missing = [p for p in tracked if not any(fnmatch.fnmatch(str(Path(p).relative_to("models")), g) for g in globs)]
+    assert missing == [], missing
+
+
+def test_ci_builds_installs_and_runs_the_wheel_elsewhere():
+    run = (ROOT / ".ci" / "run").read_text()
+    wheel = (ROOT / ".ci" / "wheel").read_text()
+    assert ".ci/wheel" in run
+    for step in ("pip wheel .", "python -m venv --system-site-packages", "--force-reinstall", 'cd "$work"',
+                 "-m validate list", "-m validate case seed001-terms", "startswith(sys.prefix)"):
+        assert step in wheel, step
+
+
+def test_assets_find_the_checkouts_models():
+    from validate import assets
+
+    assert assets.MODELS == ROOT / "models" and (assets.RIGS / "plate.toml").is_file()
