@@ -14,6 +14,7 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass, field, replace
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -28,6 +29,9 @@ from bifilar.rig.checks import (
     table,
     vector3,
 )
+
+if TYPE_CHECKING:
+    from bifilar.bodies.air import Air
 
 __all__ = ["Rig", "RigError", "Uncertainty", "Wire", "load_rig", "rig_from_dict", "check_reachable"]
 
@@ -67,6 +71,7 @@ class Rig:
     initial_omega: np.ndarray = field(default_factory=lambda: np.zeros(3))  # rad/s, world frame
     uncertainty: Uncertainty = field(default_factory=Uncertainty)
     source: str = "<memory>"
+    air: Air | None = None  # the optional [air] table (bifilar.bodies.air); None: a vacuum
 
     def with_initial(self, rotation=(0.0, 0.0, 0.0), omega=(0.0, 0.0, 0.0)) -> "Rig":
         """The same rig with another initial disturbance (rotation vector and angular velocity)."""
@@ -77,7 +82,7 @@ class Rig:
         )
 
 
-_TOP_KEYS = {"name", "gravity", "body", "wire", "initial", "uncertainty"}
+_TOP_KEYS = {"name", "gravity", "body", "wire", "initial", "uncertainty", "air"}
 _BODY_KEYS = {"mass", "com", "inertia"}
 _WIRE_KEYS = {"anchor", "attach", "length"}
 _INITIAL_KEYS = {"rotation", "omega"}
@@ -132,6 +137,11 @@ def rig_from_dict(data: dict, source: str = "<memory>", default_name: str = "rig
         **{k: non_negative(v, source, f"uncertainty.{k}") for k, v in unc_raw.items()}
     )
 
+    air = None
+    if "air" in data:
+        from bifilar.bodies.air import air_from_dict  # bodies.air reads fields with bifilar.rig.checks
+
+        air = air_from_dict(table(data, "air", source, mandatory=True), source)
     rig = Rig(
         name=name,
         mass=mass,
@@ -143,6 +153,7 @@ def rig_from_dict(data: dict, source: str = "<memory>", default_name: str = "rig
         initial_omega=omega,
         uncertainty=unc,
         source=source,
+        air=air,
     )
     check_reachable(rig)
     return rig
