@@ -18,6 +18,8 @@ that are propagated (docs/identification.md).
 JSON: ``{"axis", "inertia", "std", "period", "period_std", "method", "budget"}`` with the moment and
 its standard deviation in kg m^2, the period used and its standard deviation in s, the propagation
 method (``linear`` or ``monte-carlo (N)``) and each uncertainty group's share of the variance.
+With an ``[air]`` table, ``inertia`` is the apparent moment (body and air) and ``inertia_without_air``,
+``inertia_without_air_std`` and ``air_share`` are added (:mod:`bifilar.identification.air`).
 """
 
 from __future__ import annotations
@@ -49,7 +51,8 @@ def add_parser(subparsers) -> None:
 
 def run(args) -> int:
     """Identify, propagate and print; returns the exit status (errors are raised for cli.main)."""
-    from bifilar.identification.identify import identify
+    from bifilar.identification.air import vacuum, without_air
+    from bifilar.identification.identify import axis_vector, identify
     from bifilar.identification.propagation import linear, monte_carlo
 
     from ..argtypes import UsageError
@@ -58,7 +61,8 @@ def run(args) -> int:
         raise UsageError("identify: --amplitude goes with --period; a --signal's amplitude is fitted")
     if args.signal is None and (args.column is not None or args.kind != "angle"):
         raise UsageError("identify: --column and --kind go with --signal")
-    rig = load_rig(args.rig)
+    rig_in_air = load_rig(args.rig)
+    rig = vacuum(rig_in_air)  # the moment identified is the apparent one, the air's included
     if args.signal is None:
         period, period_std = args.period, rig.uncertainty.period
         ratio = identify(rig, args.axis, period, args.amplitude or 0.0).amplitude_ratio
@@ -81,6 +85,9 @@ def run(args) -> int:
         "method": result.method,
         "budget": result.budget,
     }
+    if rig_in_air.air is not None:  # the body's own moment: the air's added moment subtracted
+        own = without_air(rig_in_air, axis_vector(args.axis), result.moment, result.std)
+        report.update(inertia_without_air=own.inertia, inertia_without_air_std=own.std, air_share=own.air_share)
     if args.json:
         print(json.dumps(report))
         return 0
@@ -91,6 +98,9 @@ def run(args) -> int:
     print(f"  period {period:.9g} +- {period_std:.3g} s{amplitude}")
     shares = sorted(result.budget.items(), key=lambda kv: -kv[1])
     print("  variance budget: " + ", ".join(f"{name} {100.0 * share:.1f} %" for name, share in shares))
+    if "air_share" in report:
+        print(f"  without the air: {report['inertia_without_air']:.9g} +- {report['inertia_without_air_std']:.3g} "
+              f"{unit} (the air is {100.0 * report['air_share']:.1f} % of the measured moment)")
     return 0
 
 
