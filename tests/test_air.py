@@ -1,6 +1,7 @@
 """The air model (bifilar.bodies.air) and its use in the Kane equations, MuJoCo and identify."""
 
 import json
+import tomllib
 from dataclasses import replace
 
 import mujoco
@@ -8,14 +9,22 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from bifilar.bodies.air import added_mass, added_mass_principal, drag_parameters, drag_wrench, lamb_coefficients
+from bifilar.bodies.air import (
+    added_mass,
+    added_mass_principal,
+    drag_wrench,
+    fluid_drag,
+    fluid_momentum,
+    lamb_coefficients,
+)
 from bifilar.motion import kane_kernel as K
 from bifilar.motion.kane import KaneModel
 from bifilar.motion.simulate import simulate
-from bifilar.rig import load_rig
+from bifilar.rig import load_rig, rig_from_dict
 from bifilar.rig.statics import initial_state
 from validate.assets import RIGS
 from validate.cli import main
+from validate.engines.kane import run as kane_run
 from validate.metrics import yaw
 
 WING = (RIGS / "foam_wing.toml").read_text()
@@ -90,6 +99,28 @@ def test_kane_in_air_without_drag_keeps_body_plus_fluid_energy():
     assert np.all(np.diff(with_drag.energy) < 1e-12)  # drag only ever takes energy out
 
 
+def test_the_functions_for_other_models_are_the_kernels_terms():
+    # fluid_momentum and fluid_drag (world frame, for the N-wire model) against the Kane kernel's own.
+    r = load_rig(RIGS / "foam_wing.toml")
+    rr = replace(r, com=np.array([0.01, 0.02, -0.03]),
+                 air=replace(r.air, center=np.array([0.05, 0.0, 0.03]), axes=Rotation.from_rotvec([0.1, 0.2, 0.3]).as_matrix()))
+    model = KaneModel.from_rig(rr)
+    theta, dtheta = np.array([0.1, 0.3, 0.2, 0.05, 0.02]), np.array([0.2, -0.1, 0.3, 0.1, 0.0])
+    state = model.state(theta, dtheta)
+    R_n = K.kinematics(theta, dtheta, model.p, 0)[1]
+    maw, _, drag = K.air_terms(R_n, state.velocity, state.omega, model.p)
+    x = np.concatenate([state.velocity, state.omega])
+    assert fluid_momentum(rr.air, rr.com, state.rotation, state.velocity, state.omega) == pytest.approx(maw @ x, rel=1e-12)
+    force, torque = fluid_drag(rr.air, rr.com, state.rotation, state.velocity, state.omega)
+    assert np.concatenate([force, torque]) == pytest.approx(drag, rel=1e-12, abs=1e-18)
+
+
+def test_a_box_is_its_inscribed_ellipsoid():
+    ellipsoid = load_rig(RIGS / "foam_wing.toml")
+    text = WING.replace('shape = "ellipsoid"', 'shape = "box"').replace("size = [0.75, 0.02, 0.18]", "size = [1.5, 0.04, 0.36]")
+    assert np.array_equal(rig_from_dict(tomllib.loads(text)).air.semi_axes, ellipsoid.air.semi_axes)
+
+
 def test_vacuum_rig_has_no_air_in_the_kernel():
     m = KaneModel.from_rig(load_rig(RIGS / "plate.toml"))
     assert m.p.shape == (K.P_SIZE,) and np.all(m.p[K.P_AIR :] == 0.0)  # the air branch is skipped
@@ -111,9 +142,7 @@ def test_identify_recovers_the_wings_own_inertia_from_a_record_in_air(tmp_path, 
     # A Kane record of the wing in air (added mass and drag) with 2e-4 rad of tracker noise: the
     # apparent moment holds the air; subtracting it must give the body's own I_zz within its sigma.
     r = load_rig(RIGS / "foam_wing.toml")
-    from validate.engines.kane import run
-
-    traj = run(r, 20.0, 0.02, 1e-10)
+    traj = kane_run(r, 20.0, 0.02, 1e-10)
     angle = yaw(traj) + np.random.default_rng(1).normal(0.0, 2e-4, len(traj.t))
     record = tmp_path / "wing.csv"
     np.savetxt(record, np.column_stack([traj.t, angle]), delimiter=",", header="t,angle", comments="")

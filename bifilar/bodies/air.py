@@ -143,6 +143,17 @@ def fluid_momentum(air: Air, com: np.ndarray, rotation: np.ndarray, velocity, om
     return rot6 @ added_mass(air, com) @ rot6.T @ np.concatenate([velocity, omega])
 
 
+def fluid_drag(air: Air, com: np.ndarray, rotation: np.ndarray, velocity, omega) -> tuple[np.ndarray, np.ndarray]:
+    """The drag force (N) and torque about the COM (N m), world frame, on the body moving with COM
+    ``velocity`` and ``omega`` (world) at ``rotation`` (body -> world); ``com`` in the body frame."""
+    axes = rotation @ air.axes
+    arm = rotation @ (air.center - com)
+    velocity, omega = np.asarray(velocity, dtype=float), np.asarray(omega, dtype=float)
+    f_e, g_e = drag_wrench(axes.T @ (velocity + np.cross(omega, arm)), axes.T @ omega, drag_parameters(air))
+    force = axes @ f_e
+    return force, axes @ g_e + np.cross(arm, force)
+
+
 def drag_parameters(air: Air) -> np.ndarray:
     """(r_x, r_y, r_z, rho, mu, C_blunt, C_slender, C_angular) for :func:`drag_wrench`."""
     return np.concatenate([air.semi_axes, [air.density, air.viscosity], air.drag])
