@@ -3,7 +3,8 @@
 Units are SI and angles radians. Vectors named ``anchor`` are in the world frame (z up, gravity along
 -z); ``attach`` and ``com`` are in the body frame, whose origin and axes the file chooses freely; the
 inertia tensor is about the centre of mass along the body axes. Wire 1 is the first ``[[wire]]`` in
-the file, everywhere in this project.
+the file, everywhere in this project. An optional ``[air]`` table describes the fluid around the body
+and its aerodynamic shape (:mod:`bifilar.bodies.air`, docs/air.md); without it the body is in a vacuum.
 
 Every problem is raised as :class:`RigError`, which names the file, the field and what is wrong, so
 that the command line can print it as one line and exit with status 2.
