@@ -2,6 +2,7 @@
 wire tensions, against the Kane model's own simulated motion and the 1-DOF closed forms."""
 
 import json
+import math
 
 import numpy as np
 import pytest
@@ -13,7 +14,7 @@ from bifilar.motion import lagrange
 from bifilar.motion.kane import KaneModel
 from bifilar.motion.modes import linearize
 from bifilar.identification.propagation import LEVEL, coverage, linear, monte_carlo
-from bifilar.rig import RigError
+from bifilar.rig import RigError, load_rig
 from bifilar.motion.simulate import simulate
 from bifilar.rig.statics import initial_state, length_errors
 from bifilar.identification.tension_inertia import angular_acceleration, fit_inertia
@@ -193,40 +194,151 @@ def main():
     return cli.main
 
 
+FIELDS = {"period", "period_std", "inertia", "std", "interval95", "inertia_per_mass", "std_per_mass", "amplitude",
+          "damping", "amplitude_coefficient", "residual_rms", "outliers", "trials", "between_trial_std", "chi2_per_dof"}
+BENCH = str(RIGS / "bench_plate.toml")
+
+
+def run_json(main, capsys, *args):
+    assert main(["identify", *args, "--json"]) == 0
+    text = capsys.readouterr().out
+    assert "NaN" not in text and "Infinity" not in text  # JSON has neither
+    return json.loads(text)
+
+
 def test_cli_period_json(main, capsys):
     r = rig("bench_plate")
-    period = ident.linear_period(r, "z")
-    assert main(["identify", str(RIGS / "bench_plate.toml"), "--axis", "z", "--period", repr(period), "--json"]) == 0
-    out = json.loads(capsys.readouterr().out)
-    assert set(out) == {"axis", "inertia", "std", "period", "period_std", "method", "budget"}
+    out = run_json(main, capsys, BENCH, "--axis", "z", "--period", repr(ident.linear_period(r, "z")))
+    assert FIELDS <= set(out) and out["flags"] == []
     assert out["inertia"] == pytest.approx(0.15, rel=1e-12) and out["method"] == "linear"
     assert out["period_std"] == r.uncertainty.period and max(out["budget"], key=out["budget"].get) == "anchor"
+    # parallel-ish wires, symmetric body: I/m does not depend on the mass, so the mass's share vanishes
+    assert out["inertia_per_mass"] == pytest.approx(0.15 / 4.0, rel=1e-12)
+    assert out["budget_per_mass"]["mass"] < 1e-12 < out["budget"]["mass"]
+    # the rig's sigma (common to all trials) and the period's (repeatability) add up to the total
+    assert math.hypot(out["std_repeatability"], out["std_rig"]) == pytest.approx(out["std"], rel=1e-12)
 
 
-def test_cli_signal(main, capsys, tmp_path):
-    """A recorded torsion angle (Kane, released at 0.1 rad, 1e-4 rad noise) through the damped fit."""
+def torsion_csv(tmp_path, name, amplitude, seed, noise=1e-3, axis="z"):
+    """A recorded rotation about ``axis``: Kane, released at ``amplitude``, 30 s at 50 Hz, white noise."""
     r = rig("bench_plate")
-    start = ident.released(r, "z", 0.1)
-    run = simulate(start.model, start.state, 40.0, dt_out=0.02)
+    start = ident.released(r, axis, amplitude)
+    run = simulate(start.model, start.state, 30.0, dt_out=0.02)
     angle = Rotation.from_matrix(run.rotation @ start.rest_rotation.T).as_rotvec() @ start.axis_world
-    angle += 1e-4 * np.random.default_rng(3).standard_normal(len(angle))
-    path = tmp_path / "torsion.csv"
+    angle += noise * np.random.default_rng(seed).standard_normal(len(angle))
+    path = tmp_path / name
     np.savetxt(path, np.column_stack([run.t, angle]), delimiter=",", header="t,angle", comments="")
-    assert main(["identify", str(RIGS / "bench_plate.toml"), "--axis", "z", "--signal", str(path), "--json"]) == 0
-    out = json.loads(capsys.readouterr().out)
-    # the fit's cubic stiffness matches T(A) to O(A^2) only: ~1e-5 of the period at 0.1 rad
-    assert out["inertia"] == pytest.approx(ident.moment(r, "z"), rel=1e-4)
-    assert 0.0 < out["period_std"] < 1e-5
+    return str(path)
+
+
+def test_cli_signals_are_pooled_trials(main, capsys, tmp_path):
+    """Two Kane records (0.1 and 0.8 rad) through the exact torsion law: each and the pooled moment
+    within 3 sigma of the truth; the trials' chi^2 is reported."""
+    paths = [torsion_csv(tmp_path, "a.csv", 0.1, 3), torsion_csv(tmp_path, "b.csv", 0.8, 4)]
+    out = run_json(main, capsys, BENCH, "--axis", "z", "--signal", paths[0], "--signal", paths[1], "--law-sigma", "0")
+    truth = ident.moment(rig("bench_plate"), "z")
+    assert len(out["trials"]) == 2 and out["chi2_per_dof"] is not None and out["between_trial_std"] > 0.0
+    for trial in out["trials"]:
+        assert FIELDS - {"trials", "between_trial_std", "chi2_per_dof"} <= set(trial)
+        assert abs(trial["inertia"] - truth) < 3.0 * trial["std"]
+    assert out["trials"][1]["amplitude"][0] == pytest.approx(0.8, abs=1e-3)
+    assert abs(out["inertia"] - truth) < 3.0 * out["std_repeatability"]
+    assert out["amplitude"] is None  # per-record quantities live in the trials when there are several
+
+
+def test_cli_signal_about_a_swing_axis_uses_the_kane_series(main, capsys, tmp_path):
+    """About x (the plate turning about the wire line, a swing, not a 1-DOF torsion) the law is the
+    Kane model's period-amplitude series: at 0.3 rad its O(A^4) error is below the record's sigma."""
+    path = torsion_csv(tmp_path, "x.csv", 0.3, 6, axis="x")
+    out = run_json(main, capsys, BENCH, "--axis", "x", "--signal", path)
+    trial = out["trials"][0]
+    assert trial["law"] == "series"
+    assert abs(trial["inertia"] - ident.moment(rig("bench_plate"), "x")) < 3.0 * trial["std"]
+
+
+def test_no_uncertainty_says_nothing_was_propagated(main, capsys):
+    out = run_json(main, capsys, str(RIGS / "parallel.toml"), "--axis", "z", "--period", "2.0")
+    assert out["std"] is None and out["interval95"] is None and out["budget"] is None
+    assert any("nothing of the rig was propagated" in f for f in out["flags"])
+    main(["identify", str(RIGS / "parallel.toml"), "--axis", "z", "--period", "2.0"])
+    text = capsys.readouterr().out
+    assert "no uncertainty propagated" in text and "+- 0 " not in text
+
+
+@pytest.mark.parametrize("axis, period, flagged", [
+    ("y", "2.83", ("95 % interval reaches", "triangle inequality", "hardly depends")),  # I_yy = 0.647 +- 0.584
+    ("z", "150", ("triangle inequality",)),  # 839 kg m^2 for a 4 kg plate
+])
+def test_implausible_results_are_flagged(main, capsys, axis, period, flagged):
+    out = run_json(main, capsys, BENCH, "--axis", axis, "--period", period)
+    for words in flagged:
+        assert any(words in f for f in out["flags"]), (words, out["flags"])
+    assert out["tensor_check"]["triangle"] is False
+
+
+def write_rig(tmp_path, inertia: str, mass="4.0", com="[0.0, 0.0, 0.0]", name="rig.toml"):
+    text = (RIGS / "bench_plate.toml").read_text()
+    text = text.replace("inertia = [0.030833333333333334, 0.12083333333333333, 0.15]", f"inertia = {inertia}")
+    text = text.replace("mass = 4.0\n", f"mass = {mass}\n").replace("com = [0.0, 0.0, 0.0]", f"com = {com}")
+    path = tmp_path / name
+    path.write_text(text)
+    return str(path)
+
+
+@pytest.mark.parametrize("value", ["nan", "5.0"])  # unknown, or a start value breaking the triangle inequality
+def test_the_identified_moment_needs_no_guess(main, capsys, tmp_path, value):
+    path = write_rig(tmp_path, f"[0.030833333333333334, 0.12083333333333333, {value}]")
+    out = run_json(main, capsys, path, "--axis", "z", "--period", repr(ident.linear_period(rig("bench_plate"), "z")))
+    assert out["inertia"] == pytest.approx(0.15, rel=1e-10)
+    assert out["tensor_check"] == {"principal": pytest.approx(sorted([0.030833333333333334, 0.12083333333333333, 0.15])),
+                                   "positive_definite": True, "triangle": True}
+    # other commands still need every moment, and the file's value is checked for them
+    assert main(["modes", path]) == 2
+    assert "body.inertia" in capsys.readouterr().err
+
+
+def test_tare_and_parallel_axis_transfer(main, capsys, tmp_path):
+    """bench_plate alone, and with a 1 kg object (own I_zz 0.01) on top at z = 0.05 m: the object's
+    own moment from the two periods. The COMs lie on the axis, so the transfer terms vanish here and
+    I_obj = I - I_fixture exactly."""
+    fixture = rig("bench_plate")
+    combined = write_rig(tmp_path, "[0.04, 0.13, 0.16]", mass="5.0", com="[0.0, 0.0, 0.01]", name="loaded.toml")
+    period = ident.linear_period(load_rig(combined), "z")
+    out = run_json(main, capsys, combined, "--axis", "z", "--period", repr(period), "--tare", BENCH,
+                   "--tare-period", repr(ident.linear_period(fixture, "z")))
+    assert out["object"]["mass"] == pytest.approx(1.0, rel=1e-12)
+    assert out["object"]["com"] == pytest.approx([0.0, 0.0, 0.05], abs=1e-12)
+    assert out["object"]["inertia"] == pytest.approx(0.01, rel=1e-8)
+    assert out["object"]["std"] == pytest.approx(math.hypot(out["std"], out["tare"]["std"]), rel=1e-12)
 
 
 @pytest.mark.parametrize("args, where", [
-    (["--axis", "y", "--period", "2.0"], "bench_plate.toml: period:"),
+    (["--axis", "z", "--period", "0.01"], "identify: --period: 0.01 s: no moment"),
     (["--axis", "z", "--signal", "missing.csv"], "missing.csv: file:"),
     (["--axis", "z", "--period", "2.0", "--signal", "x.csv"], "not allowed with"),
-    (["--axis", "z", "--period", "2.0", "--column", "angle"], "--column and --kind go with --signal"),
+    (["--axis", "z", "--period", "2.0", "--column", "angle"], "--column goes with --signal"),
+    (["--axis", "z", "--period", "2.0", "--fps", "60"], "--fps goes with --signal"),
+    (["--axis", "z", "--period", "2.0", "--tare-period", "2.0"], "go with --tare"),
     (["--axis", "w", "--period", "2.0"], "invalid choice"),
 ])
 def test_cli_bad_input_is_one_line_and_status_2(main, capsys, args, where):
-    assert main(["identify", str(RIGS / "bench_plate.toml"), *args]) == 2
+    assert main(["identify", BENCH, *args]) == 2
     err = capsys.readouterr().err
     assert where in err and err.count("\n") == 1
+
+
+def test_cli_record_that_cannot_be_used_names_it(main, capsys, tmp_path):
+    path = tmp_path / "noise.csv"
+    t = np.arange(0.0, 30.0, 0.02)
+    np.savetxt(path, np.column_stack([t, 1e-3 * np.random.default_rng(0).standard_normal(t.size)]), delimiter=",",
+               header="t,angle", comments="")
+    assert main(["identify", BENCH, "--axis", "z", "--signal", str(path)]) == 2
+    err = capsys.readouterr().err
+    assert f"{path}: angle: no oscillation stands out of the noise" in err and err.count("\n") == 1
+
+
+def test_png_is_written(main, capsys, tmp_path):
+    path = torsion_csv(tmp_path, "a.csv", 0.5, 5)
+    png = tmp_path / "fit.png"
+    assert main(["identify", BENCH, "--axis", "z", "--signal", path, "--png", str(png)]) == 0
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"

@@ -1,51 +1,103 @@
 """``python -m validate``: run the validation suite, and the rig tools it is built on.
 
-Exit status: 0 success, 1 a validation check failed, 2 bad input (one line on stderr naming the
-file, the field and the problem), 3 the Kane model's taut-wire assumption failed during a run.
+Every error is one line on stderr (``error: FILE: FIELD: problem``), never a traceback; warnings
+raised during a command that then fails are dropped, so that the error stays one line. A numerical
+failure inside the physics (a singular matrix, a solver that does not converge, a spent work budget)
+is exit status 4 and names the field most likely responsible.
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import os
 import sys
+import traceback
+import warnings
+from pathlib import Path
 
 from bifilar.rig import RigError, load_rig
 
+from .argtypes import OneLineParser, UsageError, bounded_float, positive_float, whole_number
 from .commands import boat as boat_cli
 from .commands import identify as identify_cli
-from .argtypes import OneLineParser, UsageError, positive_float, whole_number
+
+OK, CHECK_FAILED, BAD_INPUT, WENT_SLACK, RUN_FAILED, INTERRUPTED, BROKEN_PIPE = 0, 1, 2, 3, 4, 130, 141
+
+EPILOG = """\
+exit status:
+  0    success
+  1    a validation check failed (all, case)
+  2    bad input: one line on stderr naming the file (or option), the field and the problem
+  3    a wire went slack and the taut-wire Kane model stopped there (simulate; the CSV ends there)
+  4    a run that failed: a numerical failure inside the physics or a spent work budget (one line
+       naming the field most likely responsible)
+  130  interrupted (Ctrl-C)
+  141  the reader of stdout went away (e.g. '| head'); nothing more is printed
+
+examples:
+  python -m validate modes models/rigs/plate.toml
+  python -m validate simulate models/rigs/plate.toml --engine kane --duration 60 --out plate.csv
+  python -m validate all -k torsion
+"""
+
+MAX_DURATION = 1e5  # s: the longest simulation one command runs (27 hours of swinging)
+RTOL_RANGE = (1e-13, 1e-4)  # below: DOP853 is at rounding; above: the energy drifts by percent per period
+
+
+class RunFailed(Exception):
+    """A run that failed (exit status 4): the message is the whole line after ``error: ``."""
 
 
 def build_parser() -> argparse.ArgumentParser:
-    parser = OneLineParser(prog="python -m validate", description=__doc__.splitlines()[0])
-    sub = parser.add_subparsers(dest="command", required=True, parser_class=OneLineParser)
+    parser = OneLineParser(prog="python -m validate", description=__doc__.splitlines()[0], epilog=EPILOG)
+    sub = parser.add_subparsers(dest="command", required=True, parser_class=OneLineParser, metavar="COMMAND")
 
-    p = sub.add_parser("all", help="run every registered validation case")
-    p.add_argument("--json", metavar="REPORT.json", help="also write the report as JSON")
-    p.add_argument("--slow", action="store_true", help="include cases tagged slow")
-    p.add_argument("--jobs", type=whole_number("--jobs", 1), default=2, help="cases run in parallel (default 2)")
-    p.add_argument("--rerun", metavar="DIR", help="also write one rerun recording per case, DIR/<case>.rrd")
+    p = sub.add_parser("all", help="run every registered validation case", epilog=EPILOG)
+    p.add_argument("--json", metavar="REPORT.json", help="also write the report as JSON (default: none)")
+    p.add_argument("--slow", action="store_true", help="include cases tagged slow (default: fast cases only)")
+    p.add_argument("-k", metavar="PATTERN", dest="pattern",
+                   help="only cases whose name contains PATTERN (or matches it, with * ? [ ]; default: all)")
+    p.add_argument("--tag", action="append", metavar="TAG",
+                   help="only cases with this tag, e.g. fast, slow (repeat for any of several; default: all)")
+    p.add_argument("--jobs", type=whole_number("--jobs", 1, 64), default=2,
+                   help="cases run in parallel worker processes, 1-64 (default: 2)")
+    p.add_argument("--rerun", metavar="DIR", help="also write one rerun recording per case, DIR/<case>.rrd (default: none)")
 
-    sub.add_parser("list", help="list the registered cases")
+    sub.add_parser("list", help="list the registered cases with their whole descriptions")
 
-    p = sub.add_parser("case", help="run one case")
-    p.add_argument("name")
-    p.add_argument("--json", metavar="REPORT.json", help="also write the report as JSON")
-    p.add_argument("--rerun", metavar="FILE.rrd", help="also write a rerun recording of the case (open: rerun FILE.rrd)")
+    p = sub.add_parser("case", help="run one case", epilog=EPILOG)
+    p.add_argument("name", help="a case name from 'python -m validate list'")
+    p.add_argument("--json", metavar="REPORT.json", help="also write the report as JSON (default: none)")
+    p.add_argument("--rerun", metavar="FILE.rrd",
+                   help="also write a rerun recording of the case, open with: rerun FILE.rrd (default: none)")
 
-    p = sub.add_parser("modes", help="rest pose, static tensions and small-oscillation periods")
-    p.add_argument("rig")
-    p.add_argument("--json", action="store_true", help="print one JSON object")
+    p = sub.add_parser("modes", help="rest pose, static tensions and small-oscillation periods", epilog=EPILOG)
+    p.add_argument("rig", help="rig file (TOML), e.g. models/rigs/plate.toml")
+    p.add_argument("--json", action="store_true", help="print one JSON object instead of text")
 
-    p = sub.add_parser("simulate", help="simulate a rig and write the trajectory CSV")
-    p.add_argument("rig")
-    p.add_argument("--engine", default="kane")
-    p.add_argument("--duration", type=positive_float("--duration"), required=True)
-    p.add_argument("--dt-out", type=positive_float("--dt-out"), default=0.01)
-    p.add_argument("--rtol", type=positive_float("--rtol"), default=1e-10)
-    p.add_argument("--out", required=True, metavar="FILE.csv")
-    p.add_argument("--rerun", metavar="FILE.rrd", help="also write a rerun recording of the run (open: rerun FILE.rrd)")
+    p = sub.add_parser("simulate", help="simulate a rig and write the trajectory CSV", epilog=EPILOG)
+    p.add_argument("rig", help="rig file (TOML); the run starts from its [initial] disturbance")
+    p.add_argument("--engine", default="kane", choices=("kane", "mujoco", "mujoco-eq"),
+                   help="kane: the hand-derived model (stops where a wire goes slack); mujoco: tendon cables "
+                        "that may go slack; mujoco-eq: equality cables (default: kane)")
+    p.add_argument("--duration", type=bounded_float("--duration", 0.0, MAX_DURATION, "s", low_open=True),
+                   required=True, help=f"simulated time, s, > 0 and at most {MAX_DURATION:g}")
+    p.add_argument("--dt-out", type=bounded_float("--dt-out", 0.0, 100.0, "s", low_open=True), default=0.01,
+                   help="output sample spacing, s, at most --duration; for mujoco a whole number of its "
+                        "4e-5 s steps (default: 0.01)")
+    p.add_argument("--rtol", type=bounded_float("--rtol", *RTOL_RANGE, ""), default=1e-10,
+                   help=f"kane integrator's relative tolerance, {RTOL_RANGE[0]:g} .. {RTOL_RANGE[1]:g} "
+                        "(default: 1e-10; mujoco ignores it)")
+    p.add_argument("--max-seconds", type=positive_float("--max-seconds"), default=600.0,
+                   help="wall-time budget of the run, s; the run stops with exit 4 when it is spent (default: 600)")
+    p.add_argument("--out", required=True, metavar="FILE.csv", help="trajectory CSV to write (whole or not at all)")
+    p.add_argument("--rerun", metavar="FILE.rrd", help="also write a rerun recording of the run (default: none)")
+
+    p = sub.add_parser("mjcf", help="write MuJoCo models of rigs: DIR/<rig>/<rig>.xml and DIR/<rig>/scene.xml",
+                       epilog=EPILOG)
+    p.add_argument("rigs", nargs="+", metavar="RIG", help="rig files (TOML); their names must differ")
+    p.add_argument("--out", required=True, metavar="DIR", help="folder that receives one folder per rig name")
 
     identify_cli.add_parser(sub)
     boat_cli.add_parser(sub)
@@ -53,22 +105,150 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: list[str] | None = None) -> int:
+    """Run one command; returns its exit status (see :data:`EPILOG`)."""
+    args = None
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        try:
+            args = build_parser().parse_args(argv)
+            _check_outputs(args)
+            code = _COMMANDS[args.command](args)
+            sys.stdout.flush()
+        except BaseException as exc:  # every way out becomes one line and an exit status
+            return _failure(exc, args)
+    _print_warnings(caught)
+    return code
+
+
+def _failure(exc: BaseException, args) -> int:
+    """The one error line for ``exc`` on stderr, and the exit status."""
+    if isinstance(exc, SystemExit):  # --help, --version
+        return exc.code if isinstance(exc.code, int) else 0
+    if isinstance(exc, BrokenPipeError) or (isinstance(exc, OSError) and exc.errno == 32 and exc.filename is None):
+        _silence_stdout()
+        return BROKEN_PIPE
+    if isinstance(exc, KeyboardInterrupt) or _caused_by_interrupt(exc):
+        _error("interrupted")
+        return INTERRUPTED
+    if isinstance(exc, (RigError, UsageError)):
+        _error(str(exc))
+        return BAD_INPUT
+    if isinstance(exc, RunFailed):
+        _error(str(exc))
+        return RUN_FAILED
+    if isinstance(exc, OSError) and exc.filename is not None:  # an output that cannot be written
+        _error(f"{exc.filename}: cannot write ({exc.strerror or exc})")
+        return BAD_INPUT
+    if isinstance(exc, Exception):
+        _error(_run_failed_line(exc, args))
+        return RUN_FAILED
+    raise exc
+
+
+def _error(line: str) -> None:
+    print(f"error: {line}", file=sys.stderr, flush=True)
+
+
+def _print_warnings(caught) -> None:
+    """Warnings of a command that succeeded, one line each, each once."""
+    seen = set()
+    for w in caught:
+        line = f"warning: {w.category.__name__}: {str(w.message).splitlines()[0] if str(w.message) else ''}"
+        if line not in seen:
+            seen.add(line)
+            print(line, file=sys.stderr)
+
+
+def _silence_stdout() -> None:
+    """Point stdout at /dev/null so that the interpreter's final flush does not fail again."""
     try:
-        args = build_parser().parse_args(argv)
-        return _COMMANDS[args.command](args)
-    except (RigError, UsageError) as exc:
-        print(f"error: {exc}", file=sys.stderr)
-        return 2
-    except OSError as exc:  # an output that cannot be written (inputs are read as RigError)
-        print(f"error: {exc.filename}: cannot write ({exc.strerror})", file=sys.stderr)
-        return 2
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+    except (OSError, ValueError):
+        pass
+
+
+def _caused_by_interrupt(exc: BaseException) -> bool:
+    """A Ctrl-C inside a compiled kernel surfaces as a SystemError whose cause is the interrupt."""
+    seen = 0
+    while exc is not None and seen < 10:
+        if isinstance(exc, KeyboardInterrupt):
+            return True
+        exc, seen = exc.__cause__ or exc.__context__, seen + 1
+    return False
+
+
+# Where a numerical failure happened -> the rig field most likely responsible. Keys are module file
+# names, or (module file, function) for a finer guess; the innermost frame of ours that matches wins.
+_LIKELY_FIELD = {
+    ("statics.py", "initial_state"): "initial",
+    ("statics.py", "taut_shift"): "initial.rotation",
+    "statics.py": "wire",  # rest pose: anchors, attachments and lengths
+    ("kane.py", "from_rig"): "body.com",
+    ("kane.py", "complete_theta5"): "wire",
+    "modes.py": "wire",
+    "simulate.py": "initial",
+    "kane_kernel.py": "initial",
+    "mjcf.py": "body",
+    "mujoco_rig.py": "initial",
+    "propagation.py": "uncertainty",
+    "identify.py": "body.inertia",
+    "signals.py": "signal",
+}
+
+
+def _likely_field(exc: BaseException) -> str:
+    frames = traceback.extract_tb(exc.__traceback__)
+    for frame in reversed(frames):
+        name = Path(frame.filename).name
+        if "bifilar" not in frame.filename and "validate" not in frame.filename:
+            continue
+        field = _LIKELY_FIELD.get((name, frame.name)) or _LIKELY_FIELD.get(name)
+        if field:
+            return field
+    return "rig"
+
+
+def _run_failed_line(exc: Exception, args) -> str:
+    source = getattr(args, "rig", None) or getattr(args, "suspension", None) or "python -m validate"
+    if isinstance(source, list):
+        source = source[0]
+    what = f"{type(exc).__name__}: {str(exc).splitlines()[0] if str(exc) else 'no message'}"
+    command = getattr(args, "command", "command")
+    if os.environ.get("VALIDATE_TRACEBACK"):
+        traceback.print_exception(exc)
+    return (f"{source}: {_likely_field(exc)}: the {command} run failed ({what}); this field is the most likely "
+            "cause (VALIDATE_TRACEBACK=1 shows where)")
+
+
+def _check_outputs(args) -> None:
+    """Every output path is checked writable before the work starts (:func:`check_writable`)."""
+    from .trajectory import check_writable
+
+    for name in ("out", "json", "rerun", "png"):
+        value = getattr(args, name, None)
+        if not isinstance(value, str):
+            continue
+        folder = (name == "rerun" and args.command == "all") or (name == "out" and args.command == "mjcf")
+        check_writable(Path(value) / "probe" if folder else value)
+
+
+def _load(path: str):
+    """The rig file and its rest pose, with every wire hanging down from its anchor."""
+    from bifilar.rig.file import check_hanging
+    from bifilar.rig.statics import rest_pose
+
+    rig = load_rig(path)
+    rest = rest_pose(rig)
+    check_hanging(rig, rest)
+    return rig, rest
 
 
 def _cmd_modes(args) -> int:
     from bifilar.motion.modes import linearize
 
-    rig = load_rig(args.rig)
-    lin = linearize(rig)
+    rig, rest = _load(args.rig)
+    lin = linearize(rig, rest)
     rest = lin.rest
     report = {
         "rig": rig.name,
@@ -85,7 +265,7 @@ def _cmd_modes(args) -> int:
         ],
     }
     if args.json:
-        print(json.dumps(report))
+        print(json.dumps(report, allow_nan=False))
         return 0
     print(f"rig {rig.name}: rest COM {_fmt(rest.com)} m, tensions {_fmt(rest.tensions)} N")
     for i, m in enumerate(lin.modes, start=1):
@@ -96,31 +276,37 @@ def _cmd_modes(args) -> int:
 
 
 def _cmd_simulate(args) -> int:
-    from bifilar.motion.simulate import IntegrationError, output_grid
+    from bifilar.motion.simulate import MAX_SAMPLES, BudgetSpent, IntegrationError
 
     from .engines import EngineInputError, engines
     from .trajectory import NonFiniteTrajectory, write_rig_csv
 
-    available = engines()
-    if args.engine not in available:
-        raise UsageError(f"--engine: unknown engine {args.engine!r} (choose from {', '.join(available)})")
+    if args.dt_out > args.duration:
+        raise UsageError(f"--duration: {args.duration:g} s is shorter than --dt-out {args.dt_out:g} s: "
+                         "the CSV would hold t = 0 only")
+    n_samples = int(args.duration / args.dt_out + 1e-9) + 1
+    if n_samples > MAX_SAMPLES:
+        raise UsageError(f"--duration: {args.duration:g} s every --dt-out {args.dt_out:g} s is {n_samples} samples, "
+                         f"more than {MAX_SAMPLES}: shorten --duration or lengthen --dt-out")
+    rig, _ = _load(args.rig)
     try:
-        output_grid(args.duration, args.dt_out)
-    except ValueError as exc:
-        raise UsageError(f"--dt-out: {exc}") from None
-    rig = load_rig(args.rig)
-    try:
-        traj = available[args.engine](rig, args.duration, args.dt_out, args.rtol)
+        traj = engines()[args.engine](rig, args.duration, args.dt_out, args.rtol, max_seconds=args.max_seconds)
+        failure = traj.meta.get("taut_failure")
+        if failure and failure[1] == 0.0:
+            raise RigError(args.rig, "initial", _slack_at_once(traj, failure[0]))
         write_rig_csv(traj, args.out)
     except EngineInputError as exc:
-        raise UsageError(f"--dt-out: {exc}") from None
+        raise UsageError(f"{exc.option}: {exc}") from None
+    except BudgetSpent as exc:
+        raise RunFailed(f"{args.rig}: initial: {exc} (--max-seconds {args.max_seconds:g}); the motion is too "
+                        "violent for this engine, or the run too long; nothing written") from None
     except (IntegrationError, NonFiniteTrajectory) as exc:
         raise RigError(args.rig, "initial", f"the {args.engine} run failed ({exc}): the motion is too violent") from None
     if args.rerun:
         from .recording import record_trajectory
 
         record_trajectory(traj, args.rerun)
-    failure = traj.meta.get("taut_failure")
+    print(_summary(args, traj))
     if failure:
         wire, t = failure
         print(
@@ -128,24 +314,69 @@ def _cmd_simulate(args) -> int:
             f"wires, so {args.out} ends there",
             file=sys.stderr,
         )
-        return 3
-    return 0
+        return WENT_SLACK
+    return OK
+
+
+def _slack_at_once(traj, wire: int) -> str:
+    tension = float(traj["tension"][0, wire - 1])
+    return (f"the disturbance is so violent that wire[{wire}] goes slack at once (a taut wire[{wire}] would have to "
+            f"push with {-tension:.6g} N at t = 0); the taut-wire kane model cannot start: try --engine mujoco "
+            "or a smaller [initial]; nothing written")
+
+
+def _summary(args, traj) -> str:
+    """One line: what ran, how far, the tension range, where it went."""
+    import numpy as np
+
+    t_end = float(traj.t[-1])
+    tension = np.asarray(traj["tension"])
+    lines = (f"{traj.engine} on {traj.meta.get('rig')}: t = 0 .. {t_end:.6g} s, {len(traj.t)} samples every "
+             f"{args.dt_out:g} s; tensions {tension.min():.6g} .. {tension.max():.6g} N; wrote {args.out}")
+    if traj.meta.get("first_slack"):
+        wire, t = traj.meta["first_slack"]
+        lines += f"; wire[{wire}] slack at t = {t:.6g} s"
+    if not traj.meta.get("taut_failure") and t_end < args.duration * (1.0 - 1e-9):
+        lines += (f"; ends at {t_end:.6g} s, the last multiple of --dt-out within --duration {args.duration:g} s "
+                  f"(the last {args.duration - t_end:.3g} s are not sampled)")
+    return lines
+
+
+def _cmd_mjcf(args) -> int:
+    from .engines.mjcf import write_model_files
+
+    loaded = [_load(path)[0] for path in args.rigs]
+    names: dict[str, str] = {}
+    for path, rig in zip(args.rigs, loaded):
+        if rig.name in names:
+            raise RigError(path, "name", f"{rig.name!r} is also the name of {names[rig.name]}: each rig's model goes to "
+                           f"{args.out}/<name>/, so the names must differ")
+        names[rig.name] = path
+    for rig in loaded:
+        for written in write_model_files(rig, Path(args.out) / rig.name):
+            print(written)
+    return OK
 
 
 def _cmd_list(args) -> int:
+    import textwrap
+
     from .suite import registered
 
     for c in registered(slow=True):
         tags = ",".join(sorted(c.tags))
-        print(f"{c.name:40s} [{tags}] {c.source}: {c.description.splitlines()[0] if c.description else ''}")
-    return 0
+        print(f"{c.name}  [{tags}]  {c.source}")
+        text = " ".join(c.description.split())
+        print(textwrap.fill(text, width=100, initial_indent="    ", subsequent_indent="    ") if text else "    -")
+    return OK
 
 
 def _cmd_all(args) -> int:
-    from .suite import registered, run_cases
+    from .suite import registered, run_cases, select
 
-    return run_cases(registered(slow=args.slow), jobs=args.jobs, json_path=args.json,
-                     on_result=_recorder(args.rerun, folder=True))
+    cases = select(registered(slow=args.slow or bool(args.tag)), args.pattern, args.tag)
+    return run_cases(cases, jobs=args.jobs, json_path=args.json, on_result=_recorder(args.rerun, folder=True),
+                     progress=True)
 
 
 def _cmd_case(args) -> int:
@@ -159,8 +390,6 @@ def _recorder(dest: str | None, folder: bool):
     file), or to ``dest/<case>.rrd`` with ``folder``."""
     if not dest:
         return None
-    from pathlib import Path
-
     from .recording import record_case
 
     return lambda result: record_case(result, Path(dest) / f"{result.name}.rrd" if folder else dest)
@@ -176,6 +405,7 @@ _COMMANDS = {
     "case": _cmd_case,
     "modes": _cmd_modes,
     "simulate": _cmd_simulate,
+    "mjcf": _cmd_mjcf,
     "identify": identify_cli.run,
     "boat": boat_cli.run,
 }

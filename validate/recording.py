@@ -33,7 +33,7 @@ from scipy.spatial.transform import Rotation
 from bifilar.bodies.composite import equivalent_box
 
 from .registry import Metric
-from .trajectory import RIG_CHANNELS, Trajectory
+from .trajectory import RIG_CHANNELS, Trajectory, check_writable
 
 if TYPE_CHECKING:
     from .suite import CaseResult
@@ -76,7 +76,9 @@ def record(path: str | Path, title: str, trajectories: Sequence[Trajectory], met
     diffs = [(ref, run, differences(ref.traj, run.traj)) for ref, run in _compared(runs)]
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(f".{path.name}.{uuid.uuid4().hex}.rrd")  # created by rerun, with default permissions
+    check_writable(path)
+    # Created by rerun, with default permissions; short whatever the final name's length.
+    tmp = path.with_name(f".{path.name[:48]}.{uuid.uuid4().hex}.rrd")
     try:
         rec = rr.RecordingStream(APP_ID)
         rec.save(tmp, default_blueprint=_blueprint(runs, diffs))
@@ -88,6 +90,9 @@ def record(path: str | Path, title: str, trajectories: Sequence[Trajectory], met
         rec.flush()
         rec.disconnect()
         os.replace(tmp, path)
+    except OSError as exc:
+        Path(tmp).unlink(missing_ok=True)
+        raise OSError(exc.errno, exc.strerror or str(exc), str(path)) from None
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
         raise

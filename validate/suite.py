@@ -6,11 +6,12 @@ never hides the others' results.
 
 from __future__ import annotations
 
+import fnmatch
 import json
 import sys
 import time
 import traceback
-from concurrent.futures import ProcessPoolExecutor
+from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import asdict, dataclass, field
 from typing import Callable
 
@@ -34,6 +35,24 @@ def registered(slow: bool = False) -> list[Case]:
 
     load_all()
     return [c for c in REGISTRY.values() if slow or "slow" not in c.tags]
+
+
+def select(cases: list[Case], pattern: str | None = None, tags: list[str] | None = None) -> list[Case]:
+    """The cases whose name contains ``pattern`` (or matches it as a glob when it has ``* ? [``) and
+    that carry one of ``tags``; none selected is a usage error."""
+    from .argtypes import UsageError
+
+    chosen = cases
+    if pattern:
+        glob = any(ch in pattern for ch in "*?[")
+        chosen = [c for c in chosen if (fnmatch.fnmatchcase(c.name, pattern) if glob else pattern in c.name)]
+    if tags:
+        chosen = [c for c in chosen if c.tags & set(tags)]
+    if not chosen:
+        known = sorted({t for c in cases for t in c.tags})
+        asked = " ".join(([f"-k {pattern}"] if pattern else []) + [f"--tag {t}" for t in tags or []])
+        raise UsageError(f"all: no case matches {asked} (tags: {', '.join(known)}; see python -m validate list)")
+    return chosen
 
 
 def find(name: str) -> Case:
@@ -61,17 +80,31 @@ def run_case(name: str, keep_trajectories: bool = False) -> CaseResult:
 
 
 def run_cases(cases: list[Case], jobs: int = 2, json_path: str | None = None,
-              on_result: Callable[[CaseResult], object] | None = None) -> int:
+              on_result: Callable[[CaseResult], object] | None = None, progress: bool = False) -> int:
     """Run the cases, print the table (and write the JSON report); 0 if all passed, else 1.
     ``on_result`` is called on every result in this process (e.g. to record it); only then are the
-    trajectories carried back from the workers."""
+    trajectories carried back from the workers. With ``progress``, each case is announced on stderr
+    as it finishes, with its verdict and wall time."""
     names = [c.name for c in cases]
     keep = on_result is not None
+    start = time.perf_counter()
+    done: dict[str, CaseResult] = {}
+
+    def finished(result: CaseResult) -> None:
+        done[result.name] = result
+        if progress:
+            verdict = "pass" if result.passed else "FAIL"
+            print(f"[{len(done)}/{len(names)}] {result.name}: {verdict} in {result.seconds:.1f} s "
+                  f"({time.perf_counter() - start:.0f} s elapsed)", file=sys.stderr, flush=True)
+
     if jobs > 1 and len(names) > 1:
         with ProcessPoolExecutor(max_workers=jobs) as pool:
-            results = list(pool.map(run_case, names, [keep] * len(names)))
+            for future in as_completed([pool.submit(run_case, n, keep) for n in names]):
+                finished(future.result())
     else:
-        results = [run_case(n, keep) for n in names]
+        for n in names:
+            finished(run_case(n, keep))
+    results = [done[n] for n in names]
     print(format_table(results))
     if on_result is not None:
         for r in results:

@@ -62,20 +62,43 @@ def atomic_write_text(path: str | Path, text: str) -> None:
 
 
 def atomic_write_bytes(path: str | Path, data: bytes) -> None:
-    """Write a whole file or nothing: write a temporary file beside it, then rename."""
+    """Write a whole file or nothing: write a temporary file beside it, then rename. Any failure is an
+    :class:`OSError` naming ``path`` (the user's file), never the temporary one."""
     path = Path(path)
-    if path.is_dir():
-        raise IsADirectoryError(errno.EISDIR, "is a directory", str(path))
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", dir=path.parent)
+    check_writable(path)
+    tmp = None
     try:
+        # The temporary name is at most ~70 characters, whatever the length of the final one (<= 255).
+        fd, tmp = tempfile.mkstemp(prefix=f".{path.name[:48]}.", suffix=".tmp", dir=path.parent)
         with os.fdopen(fd, "wb") as fh:
             fh.write(data)
         os.chmod(tmp, 0o666 & ~_umask())  # mkstemp creates 0600; give the file the usual mode
         os.replace(tmp, path)
+    except OSError as exc:
+        if tmp is not None:
+            Path(tmp).unlink(missing_ok=True)
+        raise OSError(exc.errno, exc.strerror or str(exc), str(path)) from None
     except BaseException:
-        Path(tmp).unlink(missing_ok=True)
+        if tmp is not None:
+            Path(tmp).unlink(missing_ok=True)
         raise
+
+
+def check_writable(path: str | Path) -> None:
+    """Raise :class:`OSError` (naming ``path``) unless a file can be written at ``path``: not a folder,
+    its folder exists or can be made, and is writable. Commands call this before their work, so that
+    a bad output path fails at once, not after the run."""
+    path = Path(path)
+    if path.is_dir():
+        raise IsADirectoryError(errno.EISDIR, "is a directory", str(path))
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise OSError(exc.errno, exc.strerror or str(exc), str(path)) from None
+    if not os.access(path.parent, os.W_OK | os.X_OK):
+        raise PermissionError(errno.EACCES, "Permission denied", str(path))
+    if len(path.name.encode()) > 255:
+        raise OSError(errno.ENAMETOOLONG, "File name too long", str(path))
 
 
 class NonFiniteTrajectory(ValueError):

@@ -46,6 +46,7 @@ class KaneModel:
     def from_rig(cls, rig: Rig) -> "KaneModel":
         if len(rig.wires) != 2:
             raise RigError(rig.source, "wire", f"the kane engine represents exactly two wires, found {len(rig.wires)}")
+        K.announce()
         w1, w2 = rig.wires
         c_b, d_b = w1.attach, w2.attach
         b_prime = float(np.linalg.norm(c_b - d_b))

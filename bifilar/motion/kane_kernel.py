@@ -37,6 +37,7 @@ import numpy as np
 from numba import njit
 
 from bifilar.bodies.air import drag_wrench
+from bifilar.jit import announce_compile
 from bifilar.smallmat import mm as _mm
 from bifilar.smallmat import mv as _mv
 from bifilar.smallmat import solve as _solve
@@ -298,3 +299,8 @@ def observe(Y, p, chart):
             x = np.concatenate((vel[i], omg[i]))
             energy[i] += 0.5 * (x @ _mv(air_terms(R, vel[i], omg[i], p)[0], x))
     return com, frames, vel, omg, tension, err2, energy
+
+
+def announce() -> None:
+    """Say in one line if the kernels are about to be compiled (:func:`bifilar.jit.announce_compile`)."""
+    announce_compile("the Kane kernels", rhs, observe, loads, eom, pose)

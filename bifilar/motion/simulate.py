@@ -10,10 +10,15 @@ cross-checks need in few steps. Three terminal events stop a segment:
   ``slack`` saying which wire went slack and when (the model never integrates a pushing wire).
 
 Outputs are sampled on a uniform grid from the dense output, never from the integrator's own steps.
+
+Every run has a work budget (:class:`Budget`: right-hand-side evaluations and wall time) and raises
+:class:`BudgetSpent` when it is spent, so that no input makes a run go on for ever: a motion so
+violent that the steps shrink without end is stopped, with how far it got.
 """
 
 from __future__ import annotations
 
+import time
 from dataclasses import dataclass
 
 import numpy as np
@@ -49,6 +54,48 @@ class KaneRun:
 
 class IntegrationError(RuntimeError):
     """The integrator could not continue (step size underflow: the motion is too violent)."""
+
+
+class BudgetSpent(IntegrationError):
+    """A run spent its work budget (:class:`Budget`) before reaching its end."""
+
+
+@dataclass(frozen=True)
+class Budget:
+    """The most work one run may do: right-hand-side evaluations per simulated second (plus a floor)
+    and wall-clock seconds (None: unbounded). The plate in torsion needs ~270 evaluations per simulated
+    second at rtol 1e-10 (tests/test_robust.py), and the evaluations run at ~1.5e5 per wall second
+    (benchmarks/kane.py); the default allows 1e6 per simulated second, some 4000 times an ordinary
+    run, i.e. about 7 wall seconds per simulated second before it stops a run whose steps shrink
+    without end."""
+
+    rhs_per_second: float = 1e6
+    rhs_floor: int = 1_000_000
+    seconds: float | None = None
+
+    def rhs_limit(self, duration: float) -> int:
+        return int(self.rhs_floor + self.rhs_per_second * duration)
+
+
+_CHECK_EVERY = 2000  # RHS calls between two looks at the clock (~15 ms of work)
+
+
+class _Meter:
+    """Counts RHS evaluations across segments and raises :class:`BudgetSpent` when the budget is gone."""
+
+    def __init__(self, budget: Budget, duration: float):
+        self.limit, self.seconds = budget.rhs_limit(duration), budget.seconds
+        self.start, self.calls, self.t = time.monotonic(), 0, 0.0
+
+    def tick(self, t: float) -> None:
+        self.calls += 1
+        self.t = t
+        if self.calls % _CHECK_EVERY:
+            return
+        if self.calls >= self.limit:
+            raise BudgetSpent(f"kane: work budget spent ({self.calls} right-hand-side evaluations) at t = {t:.6g} s")
+        if self.seconds is not None and time.monotonic() - self.start > self.seconds:
+            raise BudgetSpent(f"kane: wall-time budget of {self.seconds:g} s spent at t = {t:.6g} s")
 
 
 MAX_SAMPLES = 10_000_000  # an output grid larger than this is a mistake, not a request
@@ -88,9 +135,17 @@ def simulate(
     dt_out: float = 0.01,
     rtol: float = 1e-10,
     atol: float | None = None,
+    budget: Budget = Budget(),
 ) -> KaneRun:
-    """Integrate from ``state`` for ``duration`` seconds, sampling every ``dt_out`` seconds."""
+    """Integrate from ``state`` for ``duration`` seconds, sampling every ``dt_out`` seconds, within
+    ``budget`` (else :class:`BudgetSpent`)."""
     atol = 1e-2 * rtol if atol is None else atol
+    meter = _Meter(budget, duration)
+
+    def rhs(t, yy, c):
+        meter.tick(t)
+        return K.rhs(yy, p, c)
+
     grid = output_grid(duration, dt_out)
     p = model.p
     chart = preferred_chart(model, state)
@@ -101,11 +156,13 @@ def simulate(
     if slack is not None:
         return _sampled_run(model, [(y[None, :], chart)], grid, nfev, slack)
     t0, t_end = 0.0, float(grid[-1])
+    if t_end == 0.0:  # a duration shorter than dt_out: the one sample at t = 0
+        return _sampled_run(model, [(y[None, :], chart)], grid, nfev, None)
     while True:
         events = [_chart_event(chart), _slack_event(p, chart, 0), _slack_event(p, chart, 1)]
         todo = grid[grid > t0] if samples else grid
         sol = solve_ivp(
-            lambda t, yy, c=chart: K.rhs(yy, p, c),
+            lambda t, yy, c=chart: rhs(t, yy, c),
             (t0, t_end),
             y,
             method="DOP853",

@@ -19,6 +19,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from bifilar.rig.ranges import MAX_WIRES, check_ranges
 from bifilar.rig.checks import (
     RigError,
     inertia_tensor,
@@ -34,7 +35,7 @@ from bifilar.rig.checks import (
 if TYPE_CHECKING:
     from bifilar.bodies.air import Air
 
-__all__ = ["Rig", "RigError", "Uncertainty", "Wire", "load_rig", "rig_from_dict", "check_reachable"]
+__all__ = ["Rig", "RigError", "Uncertainty", "Wire", "load_rig", "rig_from_dict", "check_reachable", "check_hanging"]
 
 
 @dataclass(frozen=True)
@@ -90,14 +91,21 @@ _INITIAL_KEYS = {"rotation", "omega"}
 _UNCERTAINTY_KEYS = set(Uncertainty.__dataclass_fields__)
 
 
-def load_rig(path: str | Path) -> Rig:
-    """Read and check a rig file; raise :class:`RigError` on any problem."""
+def load_rig(path: str | Path, free_moment: int | None = None) -> Rig:
+    """Read and check a rig file; raise :class:`RigError` on any problem.
+
+    ``free_moment`` (0, 1, 2): the diagonal inertia entry being identified, which may be ``nan`` or
+    any positive start value (:func:`bifilar.rig.checks.inertia_tensor`); a ``nan`` stays in the
+    returned tensor for the caller to fill.
+    """
     data = read_toml(path)
-    return rig_from_dict(data, source=str(path), default_name=re.sub(r"[^A-Za-z0-9_.-]", "_", Path(path).stem))
+    return rig_from_dict(data, source=str(path), default_name=re.sub(r"[^A-Za-z0-9_.-]", "_", Path(path).stem),
+                         free_moment=free_moment)
 
 
-def rig_from_dict(data: dict, source: str = "<memory>", default_name: str = "rig") -> Rig:
-    """Build a checked :class:`Rig` from the parsed TOML table (see the module docstring)."""
+def rig_from_dict(data: dict, source: str = "<memory>", default_name: str = "rig", free_moment: int | None = None) -> Rig:
+    """Build a checked :class:`Rig` from the parsed TOML table (see the module docstring and
+    :func:`load_rig` for ``free_moment``)."""
     no_unknown(data, _TOP_KEYS, source, "")
     name = data.get("name", default_name)
     if not isinstance(name, str) or not re.fullmatch(r"[A-Za-z0-9_.-]+", name) or name.startswith("."):
@@ -108,13 +116,13 @@ def rig_from_dict(data: dict, source: str = "<memory>", default_name: str = "rig
     no_unknown(body, _BODY_KEYS, source, "body.")
     mass = positive(required(body, "mass", source, "body."), source, "body.mass")
     com = vector3(body.get("com", [0.0, 0.0, 0.0]), source, "body.com")
-    inertia = inertia_tensor(required(body, "inertia", source, "body."), source)
+    inertia = inertia_tensor(required(body, "inertia", source, "body."), source, free_moment)
 
     wires_raw = data.get("wire")
     if not isinstance(wires_raw, list) or not all(isinstance(w, dict) for w in wires_raw):
         raise RigError(source, "wire", "missing: give the wires as [[wire]] tables")
-    if len(wires_raw) < 2:
-        raise RigError(source, "wire", f"two [[wire]] tables needed, found {len(wires_raw)}")
+    if not 2 <= len(wires_raw) <= MAX_WIRES:
+        raise RigError(source, "wire", f"2 to {MAX_WIRES} [[wire]] tables needed, found {len(wires_raw)}")
     wires = []
     for i, w in enumerate(wires_raw, start=1):
         prefix = f"wire[{i}]."
@@ -156,6 +164,7 @@ def rig_from_dict(data: dict, source: str = "<memory>", default_name: str = "rig
         source=source,
         air=air,
     )
+    check_ranges(rig, free_moment)
     check_reachable(rig)
     return rig
 
@@ -164,14 +173,12 @@ def check_reachable(rig: Rig) -> None:
     """Raise unless the two wires, the anchor span and the attachment span can close a loop.
 
     The loop anchor A -> attach -> attach -> anchor B is a quadrilateral with sides |AB|, l, b', l';
-    a taut pose exists only if no side is longer than the sum of the other three, and the body
-    needs two distinct attachment points to be held by two wires.
+    a taut pose exists only if no side is longer than the sum of the other three (distinct
+    attachment points are checked with the ranges, :mod:`bifilar.rig.ranges`).
     """
     w1, w2 = rig.wires[0], rig.wires[1]
     span_top = float(np.linalg.norm(w1.anchor - w2.anchor))
     span_body = float(np.linalg.norm(w1.attach - w2.attach))
-    if span_body < 1e-9:
-        raise RigError(rig.source, "wire[2].attach", "coincides with wire[1].attach; the body would hang from one point")
     sides = {"anchor span": span_top, "wire[1].length": w1.length,
              "attachment span": span_body, "wire[2].length": w2.length}
     total = sum(sides.values())
@@ -185,3 +192,15 @@ def check_reachable(rig: Rig) -> None:
             )
 
 
+
+
+def check_hanging(rig: Rig, rest) -> None:
+    """Raise unless every wire hangs down from its anchor at the rest pose ``rest`` (a
+    :class:`bifilar.rig.statics.Rest`): an anchor below its attachment (the sign of a z flipped) makes a
+    guy wire, not a pendulum, though its tension may well be positive."""
+    for i, w in enumerate(rig.wires, start=1):
+        attach = rest.com + rest.rotation @ (w.attach - rig.com)
+        rise = float(w.anchor[2] - attach[2])
+        if rise <= 0.0:
+            raise RigError(rig.source, f"wire[{i}].anchor", f"is {-rise:.6g} m below (or level with) its attachment "
+                           "at rest: a wire must hang down from its anchor (is the sign of z right?)")

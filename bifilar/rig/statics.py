@@ -124,10 +124,13 @@ def rest_pose(rig: Rig, guess: Rest | None = None) -> Rest:
 def _polish(rig: Rig, com: np.ndarray, rotation: np.ndarray, tensions: np.ndarray) -> Rest | None:
     """Newton's method on the equilibrium equations from a pose and tensions; None if it fails."""
     weight = rig.mass * rig.gravity
-    com, rotation, tensions, residual, _ = PK.newton_equilibrium(
-        np.asarray(com, float), np.asarray(rotation, float), np.asarray(tensions, float),
-        arms(rig), anchors(rig), lengths(rig), weight, rig_scale(rig), _NEWTON_ITERATIONS,
-    )
+    try:
+        com, rotation, tensions, residual, _ = PK.newton_equilibrium(
+            np.asarray(com, float), np.asarray(rotation, float), np.asarray(tensions, float),
+            arms(rig), anchors(rig), lengths(rig), weight, rig_scale(rig), _NEWTON_ITERATIONS,
+        )
+    except np.linalg.LinAlgError:  # a singular Jacobian: a neutral direction (see _global_rest_pose)
+        return None
     if not residual <= _RESIDUAL:
         return None
     return Rest(com=com, rotation=rotation, tensions=tensions)

@@ -40,6 +40,7 @@ import numpy as np
 from numba import njit
 from scipy.integrate import solve_ivp
 
+from bifilar.jit import announce_compile
 from bifilar.smallmat import mm as _mm
 from bifilar.smallmat import mv as _mv
 
@@ -117,6 +118,7 @@ class Chain:
         self._body = np.where([f.body is not None for f in self.frames], body_index, -1).astype(np.int64)
         self._mass = _block_diag([np.diag([b.mass] * 3) for b in self.bodies], [b.inertia for b in self.bodies])
         self._f = np.concatenate([np.concatenate([b.mass * self.gravity, np.zeros(3)]) for b in self.bodies])
+        announce_compile("the TMT kernels", _kinematics)
 
     def kinematics(self, q, qd) -> Kinematics:
         """Poses and partial velocities at the state (q rad, qd rad/s)."""

@@ -5,9 +5,11 @@ semantics) and returns the rig channels of :data:`validate.trajectory.RIG_CHANNE
 ``velocity`` and ``omega`` (world frame) and ``energy`` (J, zero potential at z = 0). ``meta`` holds
 ``rig`` (name) and ``rig_spec`` (the :class:`~bifilar.rig.Rig`, for drawing); an engine whose model
 cannot continue past a slack wire sets ``taut_failure = (wire, time)``.
-An engine is ``run(rig, duration, dt_out, rtol, state=None) -> Trajectory``; ``rtol`` is the
-integrator's relative tolerance where the engine has one and is ignored otherwise; ``state`` (a
-:class:`bifilar.statics.State`) replaces the rig's initial state when a case needs another one.
+An engine is ``run(rig, duration, dt_out, rtol, state=None, *, max_seconds=None) -> Trajectory``;
+``rtol`` is the integrator's relative tolerance where the engine has one and is ignored otherwise;
+``state`` (a :class:`bifilar.statics.State`) replaces the rig's initial state when a case needs
+another one; ``max_seconds`` bounds the wall time (every engine also has a work budget of its own),
+and a spent budget raises :class:`bifilar.motion.simulate.BudgetSpent`.
 """
 
 from __future__ import annotations
@@ -23,7 +25,12 @@ EngineRun = Callable[[Rig, float, float, float], Trajectory]
 
 class EngineInputError(ValueError):
     """A run request an engine cannot honour (e.g. an output step that is not a whole number of its
-    time steps); the command line reports it as bad input."""
+    time steps); ``option`` names the command-line option at fault (``--dt-out``, ``--duration``), and
+    the command line reports it as bad input."""
+
+    def __init__(self, option: str, message: str):
+        self.option = option
+        super().__init__(message)
 
 
 def engines() -> dict[str, EngineRun]:

@@ -6,17 +6,20 @@ from scipy.spatial.transform import Rotation
 
 from bifilar.motion.kane import KaneModel
 from bifilar.rig import Rig
-from bifilar.motion.simulate import KaneRun, simulate
+from bifilar.motion.simulate import Budget, KaneRun, simulate
 from bifilar.rig.statics import State, initial_state
 
 from ..trajectory import Trajectory, rig_quaternions
 
 
-def run(rig: Rig, duration: float, dt_out: float = 0.01, rtol: float = 1e-10, state: State | None = None) -> Trajectory:
-    """Integrate from ``state`` (default: the rig's initial state); see :func:`bifilar.simulate.simulate`."""
+def run(rig: Rig, duration: float, dt_out: float = 0.01, rtol: float = 1e-10, state: State | None = None, *,
+        max_seconds: float | None = None) -> Trajectory:
+    """Integrate from ``state`` (default: the rig's initial state) within the default work budget and
+    ``max_seconds`` of wall time; see :func:`bifilar.motion.simulate.simulate`."""
     model = KaneModel.from_rig(rig)
     start = initial_state(rig) if state is None else state
-    return to_trajectory(simulate(model, start, duration, dt_out=dt_out, rtol=rtol), rig, rtol)
+    run = simulate(model, start, duration, dt_out=dt_out, rtol=rtol, budget=Budget(seconds=max_seconds))
+    return to_trajectory(run, rig, rtol)
 
 
 def to_trajectory(kr: KaneRun, rig: Rig, rtol: float) -> Trajectory:

@@ -38,6 +38,7 @@ Building is stateless and costs about a millisecond, so sweeps may build thousan
 
 from __future__ import annotations
 
+import errno
 import sys
 from dataclasses import dataclass, replace
 from pathlib import Path
@@ -263,6 +264,11 @@ def write_xml_pair(model: mujoco.MjSpec, model_file: str, scene, directory: str 
     directory = Path(directory)
     directory.mkdir(parents=True, exist_ok=True)
     model_path = directory / model_file
+    scene_path = directory / "scene.xml"
+    include = f'<include file="{model_path.name}"/>'
+    if scene_path.is_file() and include not in scene_path.read_text(errors="replace"):  # before any write
+        raise FileExistsError(errno.EEXIST, "is the scene of another model; write each model to its own folder",
+                              str(scene_path))
     atomic_write_text(model_path, model.to_xml())
     scene_spec = mujoco.MjSpec()
     scene_spec.modelname = f"{Path(model_file).stem} scene"
@@ -270,7 +276,6 @@ def write_xml_pair(model: mujoco.MjSpec, model_file: str, scene, directory: str 
     scene_spec.compiler.savecanonical = False
     scene(scene_spec)
     head, sep, tail = scene_spec.to_xml().partition(">\n")
-    scene_path = directory / "scene.xml"
     atomic_write_text(scene_path, f'{head}{sep}  <include file="{model_path.name}"/>\n\n{tail}')
     return model_path, scene_path
 

@@ -10,10 +10,15 @@ start of the last step, one step before the sampled ``qpos``; so each sample cal
 recompute them at the sampled state. That costs one forward pass per sample (1/250 of the work at the
 chosen step) and changes nothing in the trajectory: the next ``mj_step`` repeats that same forward
 pass. How velocities are started and read is explained in :func:`simulate`.
+
+Refused before a step is taken: a rig whose two cable rows are so unequally loaded that MuJoCo's soft
+constraint is ill-conditioned there (:func:`row_coupling`; a slender body), and a run of more than
+:data:`MAX_STEPS` steps. Every run has a wall-time budget (``max_seconds``).
 """
 
 from __future__ import annotations
 
+import time
 from contextlib import contextmanager
 from functools import partial
 
@@ -22,8 +27,8 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from bifilar.bodies.air import added_mass
-from bifilar.rig import Rig
-from bifilar.motion.simulate import IntegrationError, output_grid
+from bifilar.rig import Rig, RigError
+from bifilar.motion.simulate import BudgetSpent, IntegrationError, output_grid
 from bifilar.rig.statics import State, initial_state
 
 from ..trajectory import Trajectory, rig_quaternions
@@ -31,17 +36,90 @@ from . import EngineInputError, mjcf
 from .mjcf import CHOSEN, Numerics
 
 
+MAX_STEPS = 25_000_000  # 1000 s at 4e-5 s; ~3 min at the ~1.5e5 steps/s measured here (10 s of the plate in 1.6 s)
+# The largest row coupling (max diag A / min eig A) at which the cable tensions stay right. Measured on
+# a 10 kg body on 2 m wires, I = [Ix, 1, 1], 0.2 s at rest: coupling 13-417 (Ix 0.1-0.003) tensions
+# within 2e-8; 1251 (Ix 1e-3) 6e-5; 4167 (Ix 3e-4) 3.5 %; 1.25e5 (Ix 1e-5) 63 % (the shipped rigs: 1.6-2.2).
+MAX_ROW_COUPLING = 500.0
+
+
 def run(rig: Rig, duration: float, dt_out: float = 0.01, rtol: float = 1e-10, state: State | None = None, *,
-        cables: str = "tendon", numerics: Numerics = CHOSEN) -> Trajectory:
+        cables: str = "tendon", numerics: Numerics = CHOSEN, max_seconds: float | None = None) -> Trajectory:
     """Simulate from ``state`` (default: the rig's initial state) for ``duration`` s, sampled every
-    ``dt_out`` s. ``rtol`` is ignored: MuJoCo's accuracy is set by ``numerics``."""
+    ``dt_out`` s, within ``max_seconds`` of wall time. ``rtol`` is ignored: MuJoCo's accuracy is set by
+    ``numerics``. A rig whose cable rows are ill-conditioned (:func:`row_coupling` above
+    :data:`MAX_ROW_COUPLING`) is refused as a :class:`RigError` on ``body.inertia``."""
+    steps = duration / numerics.timestep
+    if steps > MAX_STEPS:
+        raise EngineInputError("--duration", f"{duration:g} s is {steps:.3g} MuJoCo steps of {numerics.timestep:g} s, "
+                               f"more than the {MAX_STEPS:.3g} one run may take")
     model = mjcf.compile_model(rig, cables, numerics)
     start = initial_state(rig) if state is None else state
-    return simulate(model, rig, start, duration, dt_out, cables, numerics.staggered)
+    coupling = row_coupling(model, rig, start)
+    if coupling > MAX_ROW_COUPLING:
+        raise RigError(rig.source, "body.inertia", f"MuJoCo's soft cables are ill-conditioned for this body (row "
+                       f"coupling {coupling:.3g} > {MAX_ROW_COUPLING:g}: one wire's pull turns the body far more than "
+                       "the other's); its tensions would be wrong by percent: use --engine kane")
+    return simulate(model, rig, start, duration, dt_out, cables, numerics.staggered, max_seconds)
+
+
+def row_coupling(model: mujoco.MjModel, rig: Rig, state: State) -> float:
+    """How ill-conditioned the cable rows are at ``state``: max diag(A) / min eig(A) of the cables'
+    inverse inertia A = J M^-1 J^T (J: tendon Jacobian). MuJoCo regularises each soft row by about
+    (1 - d) / d times its own diagonal of A, so a direction of A much weaker than its diagonal (a body
+    that turns easily under one wire's pull, e.g. a slender rod) is softened far more than (1 - d) and
+    its tension swings."""
+    data = mujoco.MjData(model)
+    data.qpos[:], data.qvel[:] = mjcf.state_qpos_qvel(rig, state)
+    mujoco.mj_forward(model, data)
+    A = _cable_inverse_inertia(model, data)
+    return float(np.diag(A).max() / max(np.linalg.eigvalsh(A)[0], np.finfo(float).tiny))
+
+
+def _tendon_jacobian(model: mujoco.MjModel, data: mujoco.MjData) -> np.ndarray:
+    return np.asarray(data.ten_J, dtype=float).reshape(model.ntendon, model.nv)
+
+
+def _cable_inverse_inertia(model: mujoco.MjModel, data: mujoco.MjData) -> np.ndarray:
+    """A = J M^-1 J^T (ntendon x ntendon) at the current forward pass."""
+    J = _tendon_jacobian(model, data)
+    X = np.empty_like(J)
+    mujoco.mj_solveM(model, data, X, J)  # rows: M^-1 J_i^T (M is symmetric)
+    return J @ X.T
+
+
+def settled_tensions(model: mujoco.MjModel, data: mujoco.MjData, cables: str) -> np.ndarray:
+    """The tensions (N) a rigid cable would carry at the current state (after ``mj_forward``): each taut
+    wire's length has zero second derivative, J qacc + J' qvel = 0 with qacc = a0 - M^-1 J^T T, so
+    A T = J a0 + J' qvel (a0: MuJoCo's unconstrained acceleration ``qacc_smooth``; J' qvel by a central
+    difference of J qvel along qvel). A tendon cable that would have to push is slack (0) and the
+    others are solved without it; an equality cable keeps its sign."""
+    J = _tendon_jacobian(model, data)
+    v = data.qvel.copy()
+    eps = 1e-6 / max(float(np.abs(v).max()), 1.0)  # s; central difference, error ~ (|v| eps)^2
+    probe = mujoco.MjData(model)
+    rates = []
+    for sign in (1.0, -1.0):
+        probe.qpos[:] = data.qpos
+        mujoco.mj_integratePos(model, probe.qpos, v, sign * eps)
+        mujoco.mj_fwdPosition(model, probe)
+        rates.append(_tendon_jacobian(model, probe) @ v)
+    curvature = (rates[0] - rates[1]) / (2.0 * eps)
+    rhs = J @ data.qacc_smooth + curvature
+    A = _cable_inverse_inertia(model, data)
+    taut = np.ones(len(rhs), dtype=bool)
+    tension = np.zeros(len(rhs))
+    while taut.any():
+        sub = np.linalg.solve(A[np.ix_(taut, taut)], rhs[taut])
+        if cables != "tendon" or sub.min() >= 0.0:
+            tension[taut] = sub
+            break
+        taut[np.flatnonzero(taut)[np.argmin(sub)]] = False
+    return tension
 
 
 def simulate(model: mujoco.MjModel, rig: Rig, state: State, duration: float, dt_out: float, cables: str,
-             staggered: bool = True) -> Trajectory:
+             staggered: bool = True, max_seconds: float | None = None) -> Trajectory:
     """Step a compiled rig model from ``state`` and sample the rig channels every ``dt_out`` s.
 
     With ``staggered`` (single-step integrators), the velocities are those of a leapfrog: MuJoCo's
@@ -54,15 +132,19 @@ def simulate(model: mujoco.MjModel, rig: Rig, state: State, duration: float, dt_
     there carries the correction that keeps the leapfrog on the wire's sphere; a pass at ``v(t)``
     misses it, about m v^2 / (2 L) (measured 27 N of 566 N on the plate at h = 1e-4 s).
 
-    The first sample is a soft row at zero stretch and zero stretch rate: it carries about d of the
-    static load and none of the velocity-dependent part (MuJoCo's reference acceleration has no
-    term for the curvature of the wire's path; the stretch and stretch rate that supply it build up
-    within two steps). The plate at rest reads 1.8 % low at t = 0, the side-sway at 1 rad/s 15 %
-    low; from the second sample on, both agree with Kane to 2e-7. Compare tensions from t = dt_out.
+    At t = 0 the soft rows have zero stretch and zero stretch rate: they carry about d of the static
+    load and none of the velocity-dependent part (MuJoCo's reference acceleration has no term for the
+    curvature of the wire's path; the stretch and stretch rate that supply it build up within two
+    steps), so the plate at rest would read 1.8 % low, the side-sway at 1 rad/s 15 % low. The first
+    sample's tension is therefore the settled one, :func:`settled_tensions` (what a rigid cable carries
+    at that state, from MuJoCo's own J, M and unconstrained acceleration); from the second sample on
+    the soft rows' own forces agree with Kane to 2e-7.
     """
     nstep = round(dt_out / model.opt.timestep)
     if nstep < 1 or abs(nstep * model.opt.timestep - dt_out) > 1e-9 * dt_out:
-        raise EngineInputError(f"dt_out = {dt_out:g} s is not a whole number of time steps ({model.opt.timestep:g} s)")
+        raise EngineInputError("--dt-out", f"{dt_out:g} s is not a whole number of MuJoCo time steps "
+                               f"({model.opt.timestep:g} s)")
+    started = time.monotonic()
     times = output_grid(duration, dt_out)
     n_out = len(times)
     data = mujoco.MjData(model)
@@ -79,8 +161,10 @@ def simulate(model: mujoco.MjModel, rig: Rig, state: State, duration: float, dt_
                 mujoco.mj_step(model, data, nstep)
             mujoco.mj_forward(model, data)
             _check_warnings(data, k * dt_out)
+            if max_seconds is not None and time.monotonic() - started > max_seconds:
+                raise BudgetSpent(f"mujoco: wall-time budget of {max_seconds:g} s spent at t = {k * dt_out:.6g} s")
             qpos[k] = data.qpos
-            tension[k] = cable_tensions(data, rows)
+            tension[k] = cable_tensions(data, rows) if k else settled_tensions(model, data, cables)
             length[k] = data.ten_length
             if k:
                 qvel[k] = data.qvel + half * data.qacc

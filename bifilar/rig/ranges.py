@@ -1,0 +1,110 @@
+"""Physical ranges of every rig-file field: what a real rig can be and the numerics can hold.
+
+A rig file that parses can still describe something no bifilar pendulum is (a 1e-30 kg body, 1e200 m
+coordinates, two attachments 10 nm apart, a spin of 1e15 rad/s): the physics would then fail deep in
+a matrix factorisation or an integrator, or run for ever. These checks refuse such a file up front,
+in one line naming the field, with the range and its reason. Absolute ranges bound each quantity by
+what a bench can hold; the scale-aware ones compare it with the rig's own size
+
+    S = the longest of the wire lengths, the anchor span and the attachment span (m),
+
+so that a 5 cm model and a 50 m hall are judged alike. The table :data:`RANGES` is what
+``docs/rig-file.md`` documents; :func:`check_ranges` applies it to a parsed rig.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from bifilar.rig.checks import RigError, within
+
+# field -> (low, high, unit, reason). Absolute ranges.
+RANGES = {
+    "gravity": (0.1, 100.0, "m/s^2", "from a small moon to ten times the Earth's"),
+    "body.mass": (1e-3, 1e6, "kg", "from a gram to a thousand tonnes"),
+    "wire[i].length": (1e-3, 1e3, "m", "from a millimetre to a kilometre"),
+    "coordinates": (-1e4, 1e4, "m", "every component of anchor, attach and com"),
+}
+MAX_WIRES = 64  # a rig is a body on a few wires; a 100,000-wire file is a mistake (it crashed MuJoCo)
+MIN_ATTACH_SPAN = 1e-3  # x S: closer attachments hang the body from one point (a 1e-8 m pair is singular)
+MAX_COM_OFFSET = 10.0  # x S: the COM's distance from the nearest attachment
+MIN_INERTIA = 1e-9  # x m S^2: the smallest principal moment; below it the rotation is numerically rigid
+MAX_INERTIA = 1e3  # x m S^2: the largest; a body 30 rig sizes across on a rig of size S is not hung by it
+MAX_ROTATION = np.pi  # rad: |initial.rotation|; every orientation has a rotation vector of norm <= pi
+MAX_OMEGA = 100.0  # x sqrt(g / l_min): |initial.omega|, a hundred times the pendulum's own rate
+MAX_RELATIVE_SIGMA = 0.5  # uncertainty.* against its quantity: larger is not a measurement
+MIN_RELATIVE_SIGMA = 1e-12  # a positive sigma below this of its quantity is rounding noise (or a denormal)
+MAX_PERIOD_SIGMA = 100.0  # s
+
+
+def rig_size(wires) -> float:
+    """S (m): the longest of the wire lengths, the anchor span and the attachment span."""
+    anchors = np.array([w.anchor for w in wires])
+    attach = np.array([w.attach for w in wires])
+    return float(max(max(w.length for w in wires), np.linalg.norm(anchors[0] - anchors[-1]),
+                     np.linalg.norm(attach[0] - attach[-1])))
+
+
+def check_ranges(rig, free_moment: int | None = None) -> None:
+    """Raise :class:`RigError` for the first field of ``rig`` (a :class:`bifilar.rig.Rig`) outside its
+    range; the order is the file's (gravity, body, wires, initial, uncertainty). ``free_moment``: the
+    diagonal inertia entry being identified (its value is unknown or a guess): only the others are
+    held to the inertia range."""
+    src = rig.source
+    low, high, unit, why = RANGES["gravity"]
+    within(rig.gravity, low, high, src, "gravity", unit, why)
+    low, high, unit, why = RANGES["body.mass"]
+    within(rig.mass, low, high, src, "body.mass", unit, why)
+    low, high, unit, why = RANGES["coordinates"]
+    for k, x in enumerate(rig.com):
+        within(float(x), low, high, src, f"body.com[{k}]", unit, why)
+    for i, w in enumerate(rig.wires, start=1):
+        for name, vec in (("anchor", w.anchor), ("attach", w.attach)):
+            for k, x in enumerate(vec):
+                within(float(x), low, high, src, f"wire[{i}].{name}[{k}]", unit, why)
+        lo, hi, u, reason = RANGES["wire[i].length"]
+        within(w.length, lo, hi, src, f"wire[{i}].length", u, reason)
+
+    size = rig_size(rig.wires)
+    span = float(np.linalg.norm(rig.wires[0].attach - rig.wires[1].attach))
+    if span < MIN_ATTACH_SPAN * size:
+        raise RigError(src, "wire[2].attach", f"coincides with wire[1].attach ({span:.3g} m apart, less than "
+                       f"{MIN_ATTACH_SPAN:g} of the rig's size {size:.3g} m): the body would hang from one point")
+    offset = min(float(np.linalg.norm(rig.com - w.attach)) for w in rig.wires)
+    within(offset, 0.0, MAX_COM_OFFSET * size, src, "body.com", "m",
+           f"its distance from the nearest attachment, at most {MAX_COM_OFFSET:g} x the rig's size {size:.3g} m")
+    known = [i for i in range(3) if i != free_moment]
+    moments = np.linalg.eigvalsh(rig.inertia[np.ix_(known, known)])
+    scale = rig.mass * size**2
+    if moments[0] < MIN_INERTIA * scale or moments[-1] > MAX_INERTIA * scale:
+        raise RigError(src, "body.inertia", f"principal moments {_fmt(moments)} kg m^2 outside {MIN_INERTIA:g} .. "
+                       f"{MAX_INERTIA:g} x mass x size^2 = {MIN_INERTIA * scale:.3g} .. {MAX_INERTIA * scale:.3g} kg m^2")
+
+    within(float(np.linalg.norm(rig.initial_rotation)), 0.0, MAX_ROTATION, src, "initial.rotation", "rad",
+           "the rotation vector's norm; every orientation has one of norm <= pi")
+    rate = np.sqrt(rig.gravity / min(w.length for w in rig.wires))
+    within(float(np.linalg.norm(rig.initial_omega)), 0.0, MAX_OMEGA * rate, src, "initial.omega", "rad/s",
+           f"|omega| at most {MAX_OMEGA:g} x sqrt(g / shortest wire) = {MAX_OMEGA * rate:.3g} rad/s")
+    _check_sigmas(rig, size)
+
+
+def _check_sigmas(rig, size: float) -> None:
+    unc = rig.uncertainty
+    scales = {
+        "length": (min(w.length for w in rig.wires), "m"),
+        "anchor": (size, "m"),
+        "attach": (size, "m"),
+        "com": (size, "m"),
+        "mass": (rig.mass, "kg"),
+    }
+    for name, (scale, unit) in scales.items():
+        sigma = getattr(unc, name)
+        if sigma:
+            within(sigma, MIN_RELATIVE_SIGMA * scale, MAX_RELATIVE_SIGMA * scale, rig.source, f"uncertainty.{name}",
+                   unit, f"0 or {MIN_RELATIVE_SIGMA:g} .. {MAX_RELATIVE_SIGMA:g} of the quantity, {scale:.6g} {unit}")
+    if unc.period:
+        within(unc.period, 1e-12, MAX_PERIOD_SIGMA, rig.source, "uncertainty.period", "s", "0 or 1e-12 .. 100 s")
+
+
+def _fmt(values) -> str:
+    return "[" + ", ".join(f"{v:.3g}" for v in values) + "]"
