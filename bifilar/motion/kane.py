@@ -15,6 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from bifilar.bodies.air import added_mass, drag_parameters
 from bifilar.motion import kane_kernel as K
 from bifilar.rig import Rig, RigError
 from bifilar.rig.statics import State
@@ -75,6 +76,8 @@ class KaneModel:
         p[8:11] = ab
         p[11:20] = inertia_n.ravel()
         p[20:23] = w1.anchor
+        if rig.air is not None:
+            _air_parameters(p, rig, frame)
         return cls(
             b=float(np.linalg.norm(ab)),
             b_prime=b_prime,
@@ -166,6 +169,18 @@ class KaneModel:
         beta = 2.0 * (kin[8].T @ kin[7])
         gamma = -beta[:4] / beta[4]
         return th[4], float(gamma @ np.asarray(dtheta14, dtype=float))
+
+
+def _air_parameters(p: np.ndarray, rig: Rig, frame: np.ndarray) -> None:
+    """Fill the kernel's air entries: the added-mass tensor about the COM, the ellipsoid's centre
+    and axes, all turned from the rig's body axes to the n~ frame (columns of ``frame``)."""
+    air = rig.air
+    rot6 = np.kron(np.eye(2), frame)
+    p[K.P_AIR] = 1.0
+    p[K.P_AIR_MASS] = (rot6.T @ added_mass(air, rig.com) @ rot6).ravel()
+    p[K.P_AIR_CENTER] = frame.T @ (air.center - rig.com)
+    p[K.P_AIR_AXES] = (frame.T @ air.axes).ravel()
+    p[K.P_AIR_DRAG] = drag_parameters(air)
 
 
 def wire_angles(u: np.ndarray, chart: int) -> tuple[float, float]:

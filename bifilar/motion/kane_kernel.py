@@ -22,6 +22,12 @@ Vdot theta' as the acceleration of R* at zero theta'', and so on. tests/test_kan
 each against finite differences of the kinematics and against the appendix where it is right;
 docs/thesis-corrections.md lists where it is not.
 
+Air (docs/air.md): with ``p[P_AIR]`` set, the fluid's impulse [P; L] = M_A,w [v; omega] (world frame,
+L about R*, M_A,w the added-mass tensor of :mod:`bifilar.bodies.air` turned to the world) and the drag
+enter as a wrench on the body: force -dP/dt + F_drag, torque about R* -(dL/dt + v x P) + G_drag
+(Lamb 1932 §124). Its acceleration part adds [Vn; Gn]^T M_A,w [V; G] to the generalised inertia, the
+rest is an active force. Without air the code path is skipped and the equations are those above.
+
 Parameter vector layout: see :data:`P_*` indices.
 """
 
@@ -30,6 +36,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from bifilar.bodies.air import drag_wrench
 from bifilar.jit import announce_compile
 from bifilar.smallmat import mm as _mm
 from bifilar.smallmat import mv as _mv
@@ -41,7 +48,12 @@ P_L, P_LP, P_BP, P_R, P_SLAM, P_CLAM, P_M, P_G = range(8)
 P_AB = slice(8, 11)  # B - A, world frame
 P_INERTIA = slice(11, 20)  # inertia about R* in the n~ frame, row-major
 P_B = slice(20, 23)  # anchor B of wire 1, world frame
-P_SIZE = 23
+P_AIR = 23  # 1.0 with air, 0.0 in a vacuum
+P_AIR_MASS = slice(24, 60)  # 6x6 added-mass tensor about R* in the n~ frame, row-major
+P_AIR_CENTER = slice(60, 63)  # the air's ellipsoid centre from R*, n~ frame
+P_AIR_AXES = slice(63, 72)  # the ellipsoid's axes (columns) in the n~ frame, row-major
+P_AIR_DRAG = slice(72, 80)  # bifilar.bodies.air.drag_parameters
+P_SIZE = 80
 
 
 @njit(cache=True)
@@ -137,6 +149,31 @@ def inertia_world(R, p):
 
 
 @njit(cache=True)
+def air_terms(R, v, omega, p):
+    """The air's M_A,w (6x6, world, about R*), its velocity terms b (the fluid's wrench is
+    -(M_A,w [acc; alpha] + b) plus the drag) and the drag wrench (F; G about R*, world)."""
+    ma = p[24:60].copy().reshape((6, 6))
+    rot6 = np.zeros((6, 6))
+    rot6[:3, :3] = R
+    rot6[3:, 3:] = R
+    maw = _mm(_mm(rot6, ma), rot6.T.copy())
+    x = np.concatenate((v, omega))
+    h = _mv(maw, x)  # [P; L]
+    spin = np.zeros(6)
+    spin[:3] = np.cross(omega, v)
+    b = -_mv(maw, spin)  # d(M_A,w)/dt x = Omega M_A,w x - M_A,w Omega x
+    b[:3] += np.cross(omega, h[:3])
+    b[3:] += np.cross(omega, h[3:]) + np.cross(v, h[:3])
+    axes = _mm(R, p[63:72].copy().reshape((3, 3)))
+    c = _mv(R, p[60:63].copy())
+    f_e, g_e = drag_wrench(_mv(axes.T.copy(), v + np.cross(omega, c)), _mv(axes.T.copy(), omega), p[72:80])
+    drag = np.empty(6)
+    drag[:3] = _mv(axes, f_e)
+    drag[3:] = _mv(axes, g_e) + np.cross(c, drag[:3])
+    return maw, b, drag
+
+
+@njit(cache=True)
 def eom(th, dth, p, chart):
     """M5 and N5 of (5.1.30): rows 1-4 are Kane's equations F_r + F_r* = 0, row 5 the loop closure
     differentiated twice (beta^T theta'' = -d2g/dt2 at zero theta'')."""
@@ -156,6 +193,12 @@ def eom(th, dth, p, chart):
     weight = np.array([0.0, 0.0, m * g])
     Iw_omega = _mv(Iw, omega)
     N5[:4] = -_mv(VnT, m * vbias + weight) - _mv(GnT, _mv(Iw, wbias) + np.cross(omega, Iw_omega))
+    if p[P_AIR] != 0.0:
+        maw, b, drag = air_terms(R, _mv(V, dth), omega, p)
+        P6 = np.vstack((V, G))
+        Pn6T = np.vstack((Vn, Gn)).T.copy()
+        M5[:4, :] += _mm(Pn6T, _mm(maw, P6))
+        N5[:4] += _mv(Pn6T, drag - b - _mv(maw, np.concatenate((vbias, wbias))))
     M5[4, :] = beta
     ddot = _mv(J, dth)
     N5[4] = -2.0 * (ddot @ ddot + d @ dbias)
@@ -215,7 +258,11 @@ def loads(th, dth, p, chart):
     A[3:, 1] = np.cross(arm_d, e2) / bp
     rhs_ = np.empty(6)
     rhs_[:3] = m * acc + np.array([0.0, 0.0, m * g])
-    rhs_[3:] = (_mv(Iw, alpha) + np.cross(omega, _mv(Iw, omega))) / bp
+    rhs_[3:] = _mv(Iw, alpha) + np.cross(omega, _mv(Iw, omega))
+    if p[P_AIR] != 0.0:  # the wires carry what the air does not: minus the fluid's wrench
+        maw, b, drag = air_terms(R, _mv(V, dth), omega, p)
+        rhs_ += _mv(maw, np.concatenate((acc, alpha))) + b - drag
+    rhs_[3:] /= bp
     At = A.T.copy()
     tension = _solve(_mm(At, A), _mv(At, rhs_))
     res = _mv(A, tension) - rhs_
@@ -226,7 +273,7 @@ def loads(th, dth, p, chart):
 def observe(Y, p, chart):
     """Observables at each row of Y = (theta, theta'): COM, n~ frame, COM velocity, angular velocity
     (world frame), tensions (N), length error of wire 2 (m; wire 1 is exact by construction) and
-    total energy (J, zero potential at z = 0)."""
+    total energy (J, zero potential at z = 0; with air, the fluid's kinetic energy included)."""
     n = Y.shape[0]
     com = np.empty((n, 3))
     frames = np.empty((n, 3, 3))
@@ -248,6 +295,9 @@ def observe(Y, p, chart):
         err2[i] = np.sqrt(d @ d) - p[P_LP]
         Iw = inertia_world(R, p)
         energy[i] = 0.5 * m * (vel[i] @ vel[i]) + 0.5 * (omg[i] @ _mv(Iw, omg[i])) + m * g * c[2]
+        if p[P_AIR] != 0.0:  # plus the fluid's kinetic energy 1/2 x^T M_A,w x
+            x = np.concatenate((vel[i], omg[i]))
+            energy[i] += 0.5 * (x @ _mv(air_terms(R, vel[i], omg[i], p)[0], x))
     return com, frames, vel, omg, tension, err2, energy
 
 

@@ -6,7 +6,8 @@ constraints' gradients (n = 6 - rank of them: 4 for two wires, 3 for three), and
 
     M dq'' + K dq = 0,   M = Z^T diag(m I, R I R^T) Z,   K = Z^T (sum_i t_i hess g_i) Z,
 
-with t_i the static tensions. K is the Hessian of the potential on the constraint manifold, exact and
+with t_i the static tensions; the body's ``[air]`` adds its added-mass tensor (about the COM, turned
+to the world) to diag(m I, R I R^T). K is the Hessian of the potential on the constraint manifold, exact and
 closed-form: no finite differences and no angles, so no rig is near a coordinate singularity (the
 thesis's angles theta_1..5 have one where the attachment line turns steeply, which made the earlier
 linearisation through them wrong there). On two-wire rigs it agrees with the exact linearisation of the
@@ -25,6 +26,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.linalg import eigh
 
+from bifilar.bodies.air import added_mass
 from bifilar.rig import Rig
 from bifilar.rig import pose_kernel as PK
 from bifilar.rig.statics import NULL_RTOL, Rest, State, anchors, arms, rest_pose, rig_scale
@@ -74,12 +76,23 @@ class Modes:
 
 
 def reduced(rig: Rig, rest: Rest) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """(Z, M, K) about ``rest`` (see the module docstring)."""
+    """(Z, M, K) about ``rest`` (see the module docstring); with ``[air]``, M gains Z^T M_A,w Z."""
     z, mr, kr, _ = PK.reduced_matrices(
         rest.com, rest.rotation, rest.tensions, arms(rig), anchors(rig), rig.inertia, rig.mass,
         rig_scale(rig), NULL_RTOL,
     )
+    if rig.air is not None:
+        mr = mr + z.T @ air_mass_world(rig, rest) @ z
     return z, mr, kr
+
+
+def air_mass_world(rig: Rig, rest: Rest) -> np.ndarray:
+    """The air's added-mass tensor (6x6, about the COM, world axes at rest) on the pose speeds
+    (COM velocity, angular velocity); zero without ``[air]``."""
+    if rig.air is None:
+        return np.zeros((6, 6))
+    rot6 = np.kron(np.eye(2), rest.rotation)
+    return rot6 @ added_mass(rig.air, rig.com) @ rot6.T
 
 
 def motion_of(rig: Rig, rest: Rest, com: np.ndarray, rotation: np.ndarray) -> str:
@@ -136,6 +149,7 @@ def linearize(rig: Rig, rest: Rest | None = None) -> Modes:
     m6 = np.zeros((6, 6))
     m6[:3, :3] = rig.mass * np.eye(3)
     m6[3:, 3:] = rest.rotation @ rig.inertia @ rest.rotation.T
+    m6 += air_mass_world(rig, rest)
     vecs = _resolve_degenerate(w2, vecs, z, m6)
     scale = max(np.linalg.norm(arms(rig), axis=1).max(), 1e-3)
     modes = []

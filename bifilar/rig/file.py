@@ -3,7 +3,8 @@
 Units are SI and angles radians. Vectors named ``anchor`` are in the world frame (z up, gravity along
 -z); ``attach`` and ``com`` are in the body frame, whose origin and axes the file chooses freely; the
 inertia tensor is about the centre of mass along the body axes. Wire 1 is the first ``[[wire]]`` in
-the file, everywhere in this project.
+the file, everywhere in this project. An optional ``[air]`` table describes the fluid around the body
+and its aerodynamic shape (:mod:`bifilar.bodies.air`, docs/air.md); without it the body is in a vacuum.
 
 Every problem is raised as :class:`RigError`, which names the file, the field and what is wrong, so
 that the command line can print it as one line and exit with status 2.
@@ -14,6 +15,7 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass, field, replace
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -29,6 +31,9 @@ from bifilar.rig.checks import (
     table,
     vector3,
 )
+
+if TYPE_CHECKING:
+    from bifilar.bodies.air import Air
 
 __all__ = ["Rig", "RigError", "Uncertainty", "Wire", "load_rig", "rig_from_dict", "check_reachable", "check_hanging"]
 
@@ -68,6 +73,7 @@ class Rig:
     initial_omega: np.ndarray = field(default_factory=lambda: np.zeros(3))  # rad/s, world frame
     uncertainty: Uncertainty = field(default_factory=Uncertainty)
     source: str = "<memory>"
+    air: Air | None = None  # the optional [air] table (bifilar.bodies.air); None: a vacuum
 
     def with_initial(self, rotation=(0.0, 0.0, 0.0), omega=(0.0, 0.0, 0.0)) -> "Rig":
         """The same rig with another initial disturbance (rotation vector and angular velocity)."""
@@ -78,7 +84,7 @@ class Rig:
         )
 
 
-_TOP_KEYS = {"name", "gravity", "body", "wire", "initial", "uncertainty"}
+_TOP_KEYS = {"name", "gravity", "body", "wire", "initial", "uncertainty", "air"}
 _BODY_KEYS = {"mass", "com", "inertia"}
 _WIRE_KEYS = {"anchor", "attach", "length"}
 _INITIAL_KEYS = {"rotation", "omega"}
@@ -140,6 +146,11 @@ def rig_from_dict(data: dict, source: str = "<memory>", default_name: str = "rig
         **{k: non_negative(v, source, f"uncertainty.{k}") for k, v in unc_raw.items()}
     )
 
+    air = None
+    if "air" in data:
+        from bifilar.bodies.air import air_from_dict  # bodies.air reads fields with bifilar.rig.checks
+
+        air = air_from_dict(table(data, "air", source, mandatory=True), source)
     rig = Rig(
         name=name,
         mass=mass,
@@ -151,6 +162,7 @@ def rig_from_dict(data: dict, source: str = "<memory>", default_name: str = "rig
         initial_omega=omega,
         uncertainty=unc,
         source=source,
+        air=air,
     )
     check_ranges(rig, free_moment)
     check_reachable(rig)

@@ -22,7 +22,9 @@ propagated (docs/identification.md); without it nothing of the rig is propagated
   the parallel-axis theorem.
 
 Exit status 2 with one line for bad input; implausible results are flagged (text and JSON ``flags``).
-JSON fields: docs/identification.md.
+JSON fields: docs/identification.md. With an ``[air]`` table the moment is the apparent one (body and
+air) and ``inertia_without_air``, ``inertia_without_air_std`` and ``air_share`` are added
+(:mod:`bifilar.identification.air`, docs/air.md).
 """
 
 from __future__ import annotations
@@ -153,14 +155,16 @@ def _start_value(rig, axis: str):
 
 def _identify(path: str, args, period, signals, amplitude="args"):
     """(report dict, trials) for one rig file (the rig, or a --tare fixture)."""
-    from bifilar.identification.identify import identify, pencil
+    from bifilar.identification.air import vacuum, without_air
+    from bifilar.identification.identify import axis_vector, identify, pencil, with_moment
     from bifilar.identification.records import read_record
     from bifilar.identification.signals import EXCESS_PRIOR
     from bifilar.identification.trials import fit_trial, pool
 
     axis = args.axis
     amplitude = args.amplitude if amplitude == "args" else amplitude
-    rig, was_nan = _start_value(load_rig(path, free_moment=AXIS_INDEX[axis]), axis)
+    rig_in_air, was_nan = _start_value(load_rig(path, free_moment=AXIS_INDEX[axis]), axis)
+    rig = vacuum(rig_in_air)  # the moment identified is the apparent one, the air's included
     flags = []
     trials = []
     p = pencil(rig, axis)
@@ -205,6 +209,13 @@ def _identify(path: str, args, period, signals, amplitude="args"):
         report["between_trial_std"] = pooled.between_trial_std
         report["chi2_per_dof"] = pooled.chi2_per_dof
     report["rig"] = rig.name
+    if rig_in_air.air is not None:  # the body's own moment: the air's added moment subtracted
+        own = without_air(rig_in_air, axis_vector(axis), report["inertia"], report["std"] or 0.0)
+        report.update(inertia_without_air=own.inertia, inertia_without_air_std=own.std, air_share=own.air_share)
+        # The air is no rigid body: the apparent tensor may break the triangle inequality; the body's must not.
+        report["tensor_check_without_air"] = check = _tensor_check(with_moment(rig, axis, own.inertia).inertia)
+        if check["positive_definite"] and check["triangle"]:
+            report["flags"] = [f for f in report["flags"] if not f.startswith("the identified tensor")]
     return report, trials
 
 
@@ -370,6 +381,9 @@ def _print(report: dict, label: str | None = None) -> None:
     std = report["period_std"]
     print(f"  period (zero amplitude) {report['period']:.9g}" + (f" +- {std:.3g}" if std else "") +
           f" s ({report['period_std_source']}); d ln T / d ln I = {report['sensitivity']:.3g}")
+    if "air_share" in report:
+        print(f"  without the air: {report['inertia_without_air']:.9g} +- {report['inertia_without_air_std']:.3g} "
+              f"{unit} (the air is {100.0 * report['air_share']:.1f} % of the measured moment)")
     if report["budget"]:
         shares = sorted(report["budget"].items(), key=lambda kv: -kv[1])
         print("  variance budget: " + ", ".join(f"{g} {100.0 * s:.1f} %" for g, s in shares))

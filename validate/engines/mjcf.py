@@ -20,6 +20,19 @@ Two cable models (``CABLES``):
     ``connect`` pins a point rather than a distance, so a single-tendon equality is the one built-in
     equality that keeps a point-to-point length.
 
+Air (``[air]``, docs/air.md): the option's ``density`` and ``viscosity`` and one ellipsoid geom with
+``fluidshape="ellipsoid"`` at the air's ellipsoid. MuJoCo's ellipsoid model has the same drag terms as
+ours (the ``fluidcoef`` blunt, slender and angular coefficients are the rig's) and no Kutta or Magnus
+lift here (``fluidcoef`` 3, 4 = 0: our model has neither). Of the added mass it applies only the
+velocity products of the fluid's impulse (Kirchhoff's terms); the acceleration term is left out
+(measured: a fluid body at rest accelerates as in a vacuum). :func:`compile_model` supplies it as the
+free joint's ``dof_armature``: the diagonal of the added-mass tensor, translational in world axes at
+rest, rotational in body axes about the body origin. Armature adds inertia without weight and without
+velocity terms, which is what the missing term is. What it cannot hold: the off-diagonal entries
+(zero when the ellipsoid's axes are the body axes and its centre the body origin, as in
+``models/rigs/foam_wing.toml``) and the turning of the translational block with the body (second order
+in the rotation). MJCF has one armature per joint, so the written XML lacks it (its header says so).
+
 Building is stateless and costs about a millisecond, so sweeps may build thousands of models.
 """
 
@@ -34,6 +47,7 @@ import mujoco
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from bifilar.bodies.air import added_mass
 from bifilar.bodies.composite import equivalent_box
 from bifilar.rig import Rig, RigError, load_rig
 from bifilar.rig.statics import Rest, State, attachments, initial_state, rest_pose
@@ -102,6 +116,7 @@ TAUT_MARGIN = 1e-12  # m
 _WIRE_RGBA = (0.85, 0.75, 0.2, 1.0)
 _BODY_RGBA = (0.3, 0.45, 0.7, 1.0)
 _BEAM_RGBA = (0.45, 0.35, 0.3, 1.0)
+_AIR_RGBA = (0.7, 0.85, 1.0, 0.25)
 _WIRE_WIDTH = 0.004  # tendon drawing radius per metre of wire
 _BEAM_SECTION = 0.02  # beam cross-section per metre of the larger of anchor span and wire length
 _MIN_BOX = 0.02  # thinnest edge of the body's drawing box, per metre of its longest edge
@@ -137,6 +152,8 @@ def build_spec(rig: Rig, cables: str = "tendon", numerics: Numerics = CHOSEN, sc
     size, box_quat = _inertia_box(rig)
     body.add_geom(spec.find_default("visual"), name="body", type=mujoco.mjtGeom.mjGEOM_BOX, size=size,
                   pos=rig.com, quat=box_quat, rgba=_BODY_RGBA)
+    if rig.air is not None:
+        _add_air(spec, body, rig)
 
     wire_class = spec.find_default("wire")
     for i, wire in enumerate(rig.wires, start=1):
@@ -167,8 +184,19 @@ def build_spec(rig: Rig, cables: str = "tendon", numerics: Numerics = CHOSEN, sc
 
 def compile_model(rig: Rig, cables: str = "tendon", numerics: Numerics = CHOSEN, scene: bool = False,
                   rest: Rest | None = None) -> mujoco.MjModel:
-    """The compiled model of :func:`build_spec`."""
-    return build_spec(rig, cables, numerics, scene, rest).compile()
+    """The compiled model of :func:`build_spec`, with the air's added mass as armature (see above)."""
+    rest = rest_pose(rig) if rest is None else rest
+    model = build_spec(rig, cables, numerics, scene, rest).compile()
+    if rig.air is not None:
+        model.dof_armature[:6] = air_armature(rig, rest)
+    return model
+
+
+def air_armature(rig: Rig, rest: Rest) -> np.ndarray:
+    """The free joint's armature for the air: the diagonal of the added-mass tensor about the body
+    origin, translation in world axes at ``rest``, rotation in body axes (kg, kg m^2)."""
+    ma = added_mass(rig.air, np.zeros(3))
+    return np.concatenate([np.diag(rest.rotation @ ma[:3, :3] @ rest.rotation.T), np.diag(ma[3:, 3:])])
 
 
 def pose_qpos(rig: Rig, com: np.ndarray, rotation: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -281,6 +309,16 @@ def _add_defaults(spec: mujoco.MjSpec, rig: Rig, cables: str, numerics: Numerics
         wire.equality.solimp = numerics.solimp
 
 
+def _add_air(spec: mujoco.MjSpec, body: mujoco.MjsBody, rig: Rig) -> None:
+    """The fluid on the option and the air's ellipsoid as a massless, non-colliding fluid geom."""
+    air = rig.air
+    spec.option.density = air.density
+    spec.option.viscosity = air.viscosity
+    body.add_geom(spec.find_default("visual"), name="air", type=mujoco.mjtGeom.mjGEOM_ELLIPSOID,
+                  size=air.semi_axes, pos=air.center, quat=Rotation.from_matrix(air.axes).as_quat(scalar_first=True),
+                  fluid_ellipsoid=1, fluid_coefs=[*map(float, air.drag), 0.0, 0.0], rgba=_AIR_RGBA)
+
+
 def _inertia_box(rig: Rig) -> tuple[np.ndarray, np.ndarray]:
     """:func:`bifilar.composite.equivalent_box` as half sizes, no edge thinner than ``_MIN_BOX`` of the
     longest (a flat body stays visible), and a wxyz quaternion (MuJoCo's order)."""
@@ -307,6 +345,9 @@ def _header(rig: Rig, cables: str, numerics: Numerics) -> str:
         f"  tendon margin {TAUT_MARGIN:g} m: a wire exactly at its length is taut.",
         "Body geom: the uniform box with the body's mass and inertia, for drawing only (no contact).",
     ]
+    if rig.air is not None:
+        lines.append("Air: fluid geom 'air' (ellipsoid model, no Kutta/Magnus lift). The added mass is NOT in this "
+                     "file: validate.engines.mjcf.compile_model sets it as dof_armature.")
     return "\n" + "\n".join("  " + line for line in lines) + "\n"
 
 

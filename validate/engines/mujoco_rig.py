@@ -26,6 +26,7 @@ import mujoco
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from bifilar.bodies.air import added_mass
 from bifilar.rig import Rig, RigError
 from bifilar.motion.simulate import BudgetSpent, IntegrationError, output_grid
 from bifilar.rig.statics import State, initial_state
@@ -224,6 +225,9 @@ def rig_channels(rig: Rig, qpos: np.ndarray, qvel: np.ndarray) -> dict[str, np.n
     quat = rig_quaternions(rot)
     spin = np.einsum("ij,ij->i", qvel[:, 3:6], qvel[:, 3:6] @ rig.inertia)  # w.Iw in body axes
     energy = 0.5 * rig.mass * np.einsum("ij,ij->i", velocity, velocity) + 0.5 * spin + rig.mass * rig.gravity * com[:, 2]
+    if rig.air is not None:  # plus the fluid's kinetic energy, as in the Kane engine (docs/air.md)
+        x = np.concatenate([np.einsum("nji,nj->ni", matrices, velocity), qvel[:, 3:6]], axis=1)  # body axes
+        energy = energy + 0.5 * np.einsum("ni,ij,nj->n", x, added_mass(rig.air, rig.com), x)
     return {"com": com, "quat": quat, "velocity": velocity, "omega": omega, "energy": energy}
 
 
