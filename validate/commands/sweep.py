@@ -6,7 +6,9 @@ Writes, whole or not at all, ``DIR/sweep.csv`` (one row per configuration; colum
 empty where not measured or not identifiable), ``clearance`` (m above the floor), ``feasible``, then
 ``motion_1..motion_4``, ``dominant_x..z`` (the uncertainty group with the largest share), ``separation``
 (smallest relative gap between two mode periods) and ``reason`` (why a row is infeasible)), and
-``DIR/summary.json`` (n, feasible, objective, best, pareto, seconds). ``--png`` adds ``DIR/sweep.png``:
+``DIR/summary.json`` (n, feasible, objective, best, pareto, seconds, mujoco_check). ``--check-mujoco K``
+runs the K best configurations in MuJoCo (:mod:`validate.studies.sweep_check`) and fails (exit 1) on a
+disagreement over 1e-6. ``--png`` adds ``DIR/sweep.png``:
 the objective over the two most varied axes (the best over the others), infeasible points marked, and the
 Pareto front. The evaluation is :mod:`bifilar.sweep`.
 """
@@ -39,6 +41,9 @@ def add_parser(subparsers):
     p.add_argument("--scheduler", metavar="ADDRESS",
                    help="run on a Dask distributed cluster at ADDRESS (e.g. tcp://127.0.0.1:8786) instead")
     p.add_argument("--png", action="store_true", help="also draw DIR/sweep.png (objective map, Pareto front)")
+    p.add_argument("--check-mujoco", type=whole_number("--check-mujoco", 0, 100), default=0, metavar="K",
+                   help="run the K best configurations in MuJoCo and compare periods and tensions "
+                        "(exit 1 if any differs by more than 1e-6; default 0: no check)")
     return p
 
 
@@ -165,11 +170,20 @@ def run(args) -> int:
             bar.close()
     seconds = time.perf_counter() - start
     data = summary(space, rows, seconds)
+    if args.check_mujoco:
+        from bifilar.sweep.choose import objective
+
+        from ..studies.sweep_check import check
+
+        ranked = sorted((r for r in rows if math.isfinite(objective(r, space.measure, space.objective))),
+                        key=lambda r: objective(r, space.measure, space.objective))
+        data["mujoco_check"] = [check(space, r["values"]) for r in ranked[: args.check_mujoco]]
     atomic_write_text(out / "sweep.csv", csv_text(list(space.axes), rows))
     atomic_write_text(out / "summary.json", json.dumps(data, indent=1, allow_nan=False) + "\n")
     if args.png:
         figure(space, rows, out / "sweep.png")
     shutil.rmtree(out / ".chunks", ignore_errors=True)  # the sweep is whole: the resume files are spent
+    failed = [c for c in data["mujoco_check"] if not c["ok"]]
     top = data["best"]
     best_text = ("no feasible configuration" if top is None else
                  "best " + ", ".join(f"{a} = {top[a]:g}" for a in space.axes) + f": {space.objective} sigma "
@@ -177,4 +191,8 @@ def run(args) -> int:
     print(f"sweep {Path(args.space).name}: {data['n']} configurations, {data['feasible']} feasible, "
           f"{seconds:.1f} s on {1 if args.scheduler is None and jobs == 1 else jobs} worker(s); {best_text}; "
           f"wrote {out / 'sweep.csv'}, {out / 'summary.json'}")
-    return 0
+    if data["mujoco_check"]:
+        worst = max(c["period_rel_error"] for c in data["mujoco_check"])
+        print(f"MuJoCo check of the {len(data['mujoco_check'])} best: largest period difference {worst:.2e}"
+              + (f"; {len(failed)} over 1e-6" if failed else " (<= 1e-6)"))
+    return 1 if failed else 0
