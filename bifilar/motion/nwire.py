@@ -22,14 +22,12 @@ from scipy.spatial.transform import Rotation
 
 from bifilar.motion import nwire_kernel as NK
 from bifilar.motion.simulate import IntegrationError, output_grid
-from bifilar.rig import Rig, RigError
-from bifilar.rig.statics import State, length_errors
+from bifilar.rig import Rig
+from bifilar.rig.statics import State, check_determinate, length_errors
 
 # Projection interval (s): the drift of a wire length between projections is the integrator's error
 # over that time, ~1e-12 m per second at rtol 1e-10 on the shipped rigs (measured, docs/nwire-model.md).
 PROJECT_EVERY = 1.0
-# Constraint rows whose singular value is below this fraction of the largest are dependent.
-_RANK_RTOL = 1e-9
 _PROJECT_TOL = 1e-14  # length residual / rig size at which a position projection stops
 
 
@@ -90,23 +88,6 @@ def state_vector(state: State) -> np.ndarray:
     return np.concatenate([state.com, quat, state.velocity, state.omega])
 
 
-def check_determinate(model: NWireModel, y: np.ndarray) -> None:
-    """Refuse wires whose constraints are dependent: inextensible wires then share the load in a way
-    rigid-body dynamics cannot determine (four parallel wires: statically indeterminate)."""
-    jac = NK.dynamics_jacobian(y, model.arms, model.anchors)
-    jac[:, 3:] /= model.scale
-    sv = np.linalg.svd(jac, compute_uv=False)
-    rank = int(np.sum(sv > _RANK_RTOL * sv[0]))
-    n = len(model.lengths)
-    if rank < n:
-        raise RigError(
-            model.rig.source, "wire",
-            f"{n} wires but only {rank} independent wire constraints: the tensions of inextensible wires are "
-            "statically indeterminate here (a rigid body has 6 degrees of freedom; parallel or redundant wires "
-            "share the load according to their stretch, which this model does not have)",
-        )
-
-
 def project(model: NWireModel, y: np.ndarray) -> np.ndarray:
     """The nearest state on the constraint manifold: every wire at its length, every length rate zero."""
     y = y.copy()
@@ -138,7 +119,8 @@ def simulate(model: NWireModel, state: State, duration: float, dt_out: float = 0
     atol = 1e-2 * rtol if atol is None else atol
     grid = output_grid(duration, dt_out)
     y = state_vector(state)
-    check_determinate(model, y)
+    rot = NK.quat_matrix(y[3:7])
+    check_determinate(model.rig, y[:3], rot)  # dependent wires: tensions undetermined
     args = model.args
     n = len(model.lengths)
     tension0 = model.tensions(y)

@@ -204,6 +204,7 @@ def _global_rest_pose(rig: Rig) -> Rest:
             raise RigError(rig.source, "wire", f"no equilibrium with every wire taut (residual {residual:.2e})")
         rotation = Rotation.from_rotvec(sol.x[3:6]).as_matrix() @ rotation0
         rest = Rest(com=sol.x[:3].copy(), rotation=rotation, tensions=sol.x[6:] * rig.mass * rig.gravity)
+    check_determinate(rig, rest.com, rest.rotation)
     slack = np.flatnonzero(rest.tensions <= 0.0)
     if slack.size:
         i = int(slack[0])
@@ -216,6 +217,25 @@ def _global_rest_pose(rig: Rig) -> Rest:
     if not _stable(rig, rest):
         raise RigError(rig.source, "wire", "the only equilibrium with every wire taut found is unstable: no rest pose")
     return rest
+
+
+def check_determinate(rig: Rig, com: np.ndarray, rotation: np.ndarray) -> None:
+    """Refuse wires whose constraints are dependent at this pose (four parallel wires, or more than
+    six): the tensions of inextensible wires are then not fixed by rigid-body statics or dynamics
+    (any self-balanced set can be added), and only the wires' stretch would share the load."""
+    s, u, _ = PK.wire_geometry(np.asarray(com, float), np.asarray(rotation, float), arms(rig), anchors(rig))
+    jac = PK.constraint_jacobian(s, u)
+    jac[:, 3:] /= rig_scale(rig)
+    sv = np.linalg.svd(jac, compute_uv=False)
+    rank = int(np.sum(sv > NULL_RTOL * sv[0]))
+    n = len(rig.wires)
+    if rank < n:
+        raise RigError(
+            rig.source, "wire",
+            f"{n} wires but only {rank} independent wire constraints at rest: the tensions of inextensible "
+            "wires are statically indeterminate (redundant wires share the load by their stretch, which "
+            "this rig file has no stiffness for)",
+        )
 
 
 def _nearest_on_neutral_axis(rig: Rig, com: np.ndarray, rotation: np.ndarray) -> np.ndarray:
