@@ -51,3 +51,22 @@ def test_four_parallel_wires_are_refused():
     rig = rig_from_dict(data, source="four.toml")
     with pytest.raises(RigError, match="statically indeterminate"):
         simulate(NWireModel.from_rig(rig), initial_state(rig), 0.1, 0.01)
+
+
+def test_tensor_from_closed_form_periods():
+    # Independent of the linearisation: on the trifilar (vertical wires, COM in the attachment plane)
+    # the yaw period with object axis e vertical is 2 pi sqrt(L e.I.e / (M g R^2)) exactly in the
+    # linear limit, so six hangings recover the tensor to rounding (1e-10 relative).
+    from bifilar.identification.tensor import Hanging, identify_tensor
+    from validate.cases.tensor import TRUE_INERTIA, mounted
+
+    axes = [np.array(v, float) / np.linalg.norm(v) for v in ((1, 0, 0), (0, 1, 0), (0, 0, 1), (1, 1, 0), (0, 1, 1), (1, 0, 1))]
+    hangings = []
+    for e in axes:
+        carrier, q = mounted(e, np.eye(3) * 0.1)
+        period = 2 * np.pi * np.sqrt(1.5 * (e @ TRUE_INERTIA @ e) / (2.0 * 9.81 * 0.09))
+        hangings.append(Hanging(carrier, period, 0.0, q))
+    result = identify_tensor(hangings)
+    np.testing.assert_allclose(result.inertia, TRUE_INERTIA, rtol=0, atol=1e-10 * 0.12)
+    with pytest.raises(RigError, match="cannot determine"):
+        identify_tensor(hangings[:5])
