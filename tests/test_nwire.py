@@ -70,3 +70,20 @@ def test_tensor_from_closed_form_periods():
     np.testing.assert_allclose(result.inertia, TRUE_INERTIA, rtol=0, atol=1e-10 * 0.12)
     with pytest.raises(RigError, match="cannot determine"):
         identify_tensor(hangings[:5])
+
+
+def test_slack_stops_the_run_with_status_3(tmp_path, capsys):
+    # Spun at 20 rad/s the platform rises steeply as it turns and must then decelerate faster than g: the
+    # tensions reach zero (all three at once, by symmetry) near t = 0.107 s; the run stops there.
+    from validate.cli import main
+
+    text = (RIGS / "trifilar.toml").read_text().replace("omega = [0.0, 0.0, 0.0]", "omega = [0.0, 0.0, 20.0]")
+    text = text.replace("rotation = [0.0, 0.0, 0.1]", "rotation = [0.0, 0.0, 0.0]")
+    path = tmp_path / "spun.toml"
+    path.write_text(text)
+    out = tmp_path / "spun.csv"
+    code = main(["simulate", str(path), "--duration", "1", "--out", str(out)])
+    err = capsys.readouterr().err
+    assert code == 3 and "went slack at t = 0.1065" in err and err.count("\n") == 1
+    rows = out.read_text().splitlines()
+    assert 10 <= len(rows) - 1 <= 12  # samples up to the slack time, 0.01 s apart

@@ -374,7 +374,8 @@ def initial_state(rig: Rig, rest: Rest | None = None) -> State:
     rate = np.einsum("ij,ij->i", dirs, np.cross(omega, pts - com))
     velocity = -np.linalg.pinv(dirs) @ rate
     miss = np.abs(dirs @ velocity + rate).max()
-    if miss > 1e-9 * max(np.abs(rate).max(), 1e-12):  # more wires than the COM velocity can satisfy
+    # More wires than the COM velocity can satisfy; 1e-9 of the attachments' speed is rounding.
+    if miss > 1e-9 * np.linalg.norm(omega) * np.linalg.norm(pts - com, axis=1).max():
         raise RigError(rig.source, "initial.omega", f"no COM velocity keeps every wire at its length "
                        f"(mismatch {miss:.3g} m/s): this spin stretches a wire")
     return State(com=com, rotation=rotation, velocity=velocity, omega=omega)
