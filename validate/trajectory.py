@@ -18,14 +18,29 @@ from typing import Any, Mapping
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-# name -> (columns in the CSV, meaning)
+# name -> (columns in the CSV, meaning); the per-wire channels have one column per wire, numbered
+# from 1 like the [[wire]] tables (tension_1..tension_N, length_error_1..length_error_N).
 RIG_CHANNELS = {
     "com": (("com_x", "com_y", "com_z"), "COM position, world frame, m"),
     "quat": (("qw", "qx", "qy", "qz"), "body->world rotation, unit quaternion, scalar first"),
     "tension": (("tension_1", "tension_2"), "wire tension, N, positive when pulling; 0 when slack"),
     "length_error": (("length_error_1", "length_error_2"), "anchor-attachment distance minus length, m"),
 }
-RIG_CSV_HEADER = ("t",) + tuple(c for cols, _ in RIG_CHANNELS.values() for c in cols)
+PER_WIRE = ("tension", "length_error")
+
+
+def rig_columns(n_wires: int = 2) -> dict[str, tuple[str, ...]]:
+    """Channel name -> CSV columns for a rig with ``n_wires`` wires."""
+    return {name: tuple(f"{name}_{i}" for i in range(1, n_wires + 1)) if name in PER_WIRE else cols
+            for name, (cols, _) in RIG_CHANNELS.items()}
+
+
+def rig_csv_header(n_wires: int = 2) -> tuple[str, ...]:
+    """The CSV header for a rig with ``n_wires`` wires."""
+    return ("t",) + tuple(c for cols in rig_columns(n_wires).values() for c in cols)
+
+
+RIG_CSV_HEADER = rig_csv_header(2)
 
 
 @dataclass(frozen=True)
@@ -112,12 +127,14 @@ def _umask() -> int:
 
 
 def write_rig_csv(traj: Trajectory, path: str | Path) -> None:
-    """The rig CSV contract: header :data:`RIG_CSV_HEADER`, one row per sample, full precision."""
+    """The rig CSV contract: header :func:`rig_csv_header` (one tension and one length-error column
+    per wire), one row per sample, full precision."""
+    n_wires = np.asarray(traj["tension"]).reshape(len(traj.t), -1).shape[1]
     columns = [traj.t[:, None]] + [np.asarray(traj[name]).reshape(len(traj.t), -1) for name in RIG_CHANNELS]
     table = np.hstack(columns)
     if not np.all(np.isfinite(table)):
         raise NonFiniteTrajectory(f"{path}: trajectory has non-finite values; nothing written")
-    lines = [",".join(RIG_CSV_HEADER)]
+    lines = [",".join(rig_csv_header(n_wires))]
     lines += [",".join(repr(float(x)) for x in row) for row in table]
     atomic_write_text(path, "\n".join(lines) + "\n")
 
@@ -126,11 +143,13 @@ def read_rig_csv(path: str | Path, engine: str = "csv") -> Trajectory:
     """Read a rig CSV written by :func:`write_rig_csv`."""
     with open(path, newline="") as fh:
         rows = list(csv.reader(fh))
-    if not rows or tuple(rows[0]) != RIG_CSV_HEADER:
-        raise ValueError(f"{path}: header is not {','.join(RIG_CSV_HEADER)}")
+    n_wires = sum(1 for c in rows[0] if c.startswith("tension_")) if rows else 0
+    header = rig_csv_header(max(n_wires, 2))
+    if not rows or tuple(rows[0]) != header:
+        raise ValueError(f"{path}: header is not {','.join(header)}")
     table = np.array(rows[1:], dtype=float)
     channels, col = {}, 1
-    for name, (cols, _) in RIG_CHANNELS.items():
+    for name, cols in rig_columns(max(n_wires, 2)).items():
         channels[name] = table[:, col : col + len(cols)]
         col += len(cols)
     return Trajectory(engine, table[:, 0], channels)

@@ -47,6 +47,8 @@ from bifilar.motion.kane import KaneModel
 from bifilar.motion.modes import NEUTRAL_RTOL, Modes, linearize
 from bifilar.identification.periods import period as crossing_period
 from bifilar.rig import Rig, RigError
+from bifilar.motion.nwire import NWireModel
+from bifilar.motion.nwire import simulate as nwire_simulate
 from bifilar.motion.simulate import simulate
 from bifilar.rig.statics import Rest, State, taut_shift
 
@@ -232,7 +234,7 @@ def linear_period(rig: Rig, axis, rest: Rest | None = None) -> float:
 class Release:
     """The rig let go from rest displaced along the mode associated with an axis (:func:`released`)."""
 
-    model: KaneModel
+    model: KaneModel | NWireModel  # Kane-Tseng for two wires, the N-wire model for more
     state: State
     period: float  # the mode's linear period, s
     rest_rotation: np.ndarray  # body -> world at rest
@@ -257,7 +259,8 @@ def released(rig: Rig, axis, amplitude: float, rest: Rest | None = None) -> Rele
     com = p.lin.rest.com + scale * shift
     com = com + taut_shift(rig, com, rotation)
     state = State(com, rotation, np.zeros(3), np.zeros(3))
-    return Release(KaneModel.from_rig(rig), state, float(2.0 * np.pi / np.sqrt(w2[k])), p.rotation, axis_world)
+    model = KaneModel.from_rig(rig) if len(rig.wires) == 2 else NWireModel.from_rig(rig)
+    return Release(model, state, float(2.0 * np.pi / np.sqrt(w2[k])), p.rotation, axis_world)
 
 
 def simulated_period(rig: Rig, axis, amplitude: float, rest: Rest | None = None) -> float:
@@ -268,7 +271,8 @@ def simulated_period(rig: Rig, axis, amplitude: float, rest: Rest | None = None)
     """
     start = released(rig, axis, amplitude, rest)
     rtol = min(_RTOL, _RTOL_PER_RAD * amplitude)
-    run = simulate(start.model, start.state, _CYCLES * start.period, dt_out=start.period / _SAMPLES_PER_PERIOD,
+    integrate = simulate if isinstance(start.model, KaneModel) else nwire_simulate
+    run = integrate(start.model, start.state, _CYCLES * start.period, dt_out=start.period / _SAMPLES_PER_PERIOD,
                    rtol=rtol)
     if run.slack is not None:
         wire, t = run.slack

@@ -80,11 +80,11 @@ class Budget:
 _CHECK_EVERY = 2000  # RHS calls between two looks at the clock (~15 ms of work)
 
 
-class _Meter:
+class Meter:
     """Counts RHS evaluations across segments and raises :class:`BudgetSpent` when the budget is gone."""
 
-    def __init__(self, budget: Budget, duration: float):
-        self.limit, self.seconds = budget.rhs_limit(duration), budget.seconds
+    def __init__(self, budget: Budget, duration: float, model: str = "kane"):
+        self.limit, self.seconds, self.model = budget.rhs_limit(duration), budget.seconds, model
         self.start, self.calls, self.t = time.monotonic(), 0, 0.0
 
     def tick(self, t: float) -> None:
@@ -93,9 +93,9 @@ class _Meter:
         if self.calls % _CHECK_EVERY:
             return
         if self.calls >= self.limit:
-            raise BudgetSpent(f"kane: work budget spent ({self.calls} right-hand-side evaluations) at t = {t:.6g} s")
+            raise BudgetSpent(f"{self.model}: work budget spent ({self.calls} right-hand-side evaluations) at t = {t:.6g} s")
         if self.seconds is not None and time.monotonic() - self.start > self.seconds:
-            raise BudgetSpent(f"kane: wall-time budget of {self.seconds:g} s spent at t = {t:.6g} s")
+            raise BudgetSpent(f"{self.model}: wall-time budget of {self.seconds:g} s spent at t = {t:.6g} s")
 
 
 MAX_SAMPLES = 10_000_000  # an output grid larger than this is a mistake, not a request
@@ -140,7 +140,7 @@ def simulate(
     """Integrate from ``state`` for ``duration`` seconds, sampling every ``dt_out`` seconds, within
     ``budget`` (else :class:`BudgetSpent`)."""
     atol = 1e-2 * rtol if atol is None else atol
-    meter = _Meter(budget, duration)
+    meter = Meter(budget, duration)
 
     def rhs(t, yy, c):
         meter.tick(t)

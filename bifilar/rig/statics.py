@@ -7,9 +7,12 @@ world frame). Both engines start from :func:`initial_state`, so that they integr
    by Newton's method on the equilibrium equations (force and moment balance, wire lengths), whose
    unknowns include the tensions;
 2. the body rotated about its COM by ``rig.initial_rotation`` (rotation vector, world frame);
-3. the COM moved by the shortest displacement that makes both wires exactly their length;
-4. angular velocity ``rig.initial_omega`` (world frame) and the smallest COM velocity that keeps both
-   wire lengths constant.
+3. the COM moved by the shortest displacement that makes every wire exactly its length (two wires:
+   the nearest point of a circle; three: the nearer of two points; more: minimum-norm Gauss-Newton,
+   see :func:`taut_shift`), refused in one line if there is none;
+4. angular velocity ``rig.initial_omega`` (world frame) and the smallest COM velocity that keeps every
+   wire length constant, refused if no COM velocity does (four or more wires and a spin that would
+   stretch one).
 """
 
 from __future__ import annotations
@@ -206,6 +209,7 @@ def _global_rest_pose(rig: Rig) -> Rest:
             raise RigError(rig.source, "wire", f"no equilibrium with every wire taut (residual {residual:.2e})")
         rotation = Rotation.from_rotvec(sol.x[3:6]).as_matrix() @ rotation0
         rest = Rest(com=sol.x[:3].copy(), rotation=rotation, tensions=sol.x[6:] * rig.mass * rig.gravity)
+    check_determinate(rig, rest.com, rest.rotation)
     slack = np.flatnonzero(rest.tensions <= 0.0)
     if slack.size:
         i = int(slack[0])
@@ -218,6 +222,25 @@ def _global_rest_pose(rig: Rig) -> Rest:
     if not _stable(rig, rest):
         raise RigError(rig.source, "wire", "the only equilibrium with every wire taut found is unstable: no rest pose")
     return rest
+
+
+def check_determinate(rig: Rig, com: np.ndarray, rotation: np.ndarray) -> None:
+    """Refuse wires whose constraints are dependent at this pose (four parallel wires, or more than
+    six): the tensions of inextensible wires are then not fixed by rigid-body statics or dynamics
+    (any self-balanced set can be added), and only the wires' stretch would share the load."""
+    s, u, _ = PK.wire_geometry(np.asarray(com, float), np.asarray(rotation, float), arms(rig), anchors(rig))
+    jac = PK.constraint_jacobian(s, u)
+    jac[:, 3:] /= rig_scale(rig)
+    sv = np.linalg.svd(jac, compute_uv=False)
+    rank = int(np.sum(sv > NULL_RTOL * sv[0]))
+    n = len(rig.wires)
+    if rank < n:
+        raise RigError(
+            rig.source, "wire",
+            f"{n} wires but only {rank} independent wire constraints at rest: the tensions of inextensible "
+            "wires are statically indeterminate (redundant wires share the load by their stretch, which "
+            "this rig file has no stiffness for)",
+        )
 
 
 def _nearest_on_neutral_axis(rig: Rig, com: np.ndarray, rotation: np.ndarray) -> np.ndarray:
@@ -242,29 +265,44 @@ def _nearest_on_neutral_axis(rig: Rig, com: np.ndarray, rotation: np.ndarray) ->
 
 
 def taut_shift(rig: Rig, com: np.ndarray, rotation: np.ndarray) -> np.ndarray:
-    """The shortest COM displacement (world, m) that puts both wires at their lengths.
+    """The shortest COM displacement (world, m) that puts every wire at its length.
 
-    Each wire confines the displaced COM to a sphere; the two spheres meet in a circle, and the
-    answer is the point of that circle nearest the current COM.
+    Each wire confines the displaced COM to a sphere. Two spheres meet in a circle: the answer is
+    its point nearest the current COM. Three spheres meet in two points (trilateration): the nearer.
+    Otherwise (four or more wires, or three whose sphere centres are nearly collinear, e.g. parallel
+    equal wires at rest, where the spheres coincide) Gauss-Newton with minimum-norm steps from zero
+    finds the nearest common point, which must hold every length to 1e-12 of the rig size.
     """
-    if len(rig.wires) != 2:
-        raise RigError(rig.source, "wire", f"the initial state is defined for two wires, found {len(rig.wires)}")
-    # Sphere i: displacement d with |d - c_i| = L_i.
-    centres = anchors(rig) - attachments(rig, com, rotation)
+    centres = anchors(rig) - attachments(rig, com, rotation)  # sphere i: |d - centres_i| = L_i
     radii = lengths(rig)
+    if len(rig.wires) == 2:
+        return _two_sphere_point(rig, centres, radii)
+    if len(rig.wires) == 3:
+        point = _three_sphere_point(centres, radii)
+        if point is not None:
+            return point
+    return _common_point(rig, centres, radii)
+
+
+def _no_taut_pose(rig: Rig) -> RigError:
+    return RigError(rig.source, "wire", "no taut pose for this orientation: the wires cannot all reach")
+
+
+def _two_sphere_point(rig: Rig, centres: np.ndarray, radii: np.ndarray) -> np.ndarray:
+    """The point nearest the origin of the circle where two spheres meet."""
     axis = centres[1] - centres[0]
     dist = float(np.linalg.norm(axis))
     if dist < 1e-12 * radii.max():
         # Parallel, equal wires: the spheres coincide; take the nearest point of the one sphere.
         if abs(radii[0] - radii[1]) > 1e-12 * radii.max():
-            raise RigError(rig.source, "wire", "no taut pose for this orientation: the wires cannot both reach")
+            raise _no_taut_pose(rig)
         norm = float(np.linalg.norm(centres[0]))
         return centres[0] - radii[0] * centres[0] / norm if norm > 0.0 else np.array([0.0, 0.0, -radii[0]])
     axis /= dist
     along = (dist**2 + radii[0] ** 2 - radii[1] ** 2) / (2.0 * dist)
     radius2 = radii[0] ** 2 - along**2
     if radius2 < 0.0:
-        raise RigError(rig.source, "wire", "no taut pose for this orientation: the wires cannot both reach")
+        raise _no_taut_pose(rig)
     centre = centres[0] + along * axis
     off = -centre - np.dot(-centre, axis) * axis
     norm = float(np.linalg.norm(off))
@@ -274,6 +312,55 @@ def taut_shift(rig: Rig, com: np.ndarray, rotation: np.ndarray) -> np.ndarray:
     return centre + np.sqrt(radius2) * off / norm
 
 
+def _three_sphere_point(centres: np.ndarray, radii: np.ndarray) -> np.ndarray | None:
+    """The nearer to the origin of the two points where three spheres meet; None when the centres
+    are too nearly collinear for trilateration to be accurate (then :func:`_common_point` decides).
+
+    In the frame e_x = (c2 - c1)/d, e_y in the plane of the centres, the points are
+    c1 + x e_x + y e_y +- z e_z with x = (r1^2 - r2^2 + d^2)/(2 d),
+    y = (r1^2 - r3^2 + i^2 + j^2)/(2 j) - (i/j) x, z^2 = r1^2 - x^2 - y^2 (i, j: c3 - c1 in e_x, e_y).
+    """
+    ex = centres[1] - centres[0]
+    d = float(np.linalg.norm(ex))
+    if d < 1e-6 * radii.max():
+        return None
+    ex /= d
+    rel = centres[2] - centres[0]
+    i = float(ex @ rel)
+    ey = rel - i * ex
+    j = float(np.linalg.norm(ey))
+    if j < 1e-6 * radii.max():
+        return None
+    ey /= j
+    ez = np.cross(ex, ey)
+    x = (radii[0] ** 2 - radii[1] ** 2 + d**2) / (2.0 * d)
+    y = (radii[0] ** 2 - radii[2] ** 2 + i**2 + j**2) / (2.0 * j) - i * x / j
+    z2 = radii[0] ** 2 - x**2 - y**2
+    if z2 < 0.0:
+        return None
+    base = centres[0] + x * ex + y * ey
+    points = [base + np.sqrt(z2) * ez, base - np.sqrt(z2) * ez]
+    return min(points, key=lambda p: float(p @ p))
+
+
+def _common_point(rig: Rig, centres: np.ndarray, radii: np.ndarray) -> np.ndarray:
+    """Gauss-Newton with minimum-norm steps from the origin on |d - c_i| = L_i; refuses if the
+    spheres have no common point (residual above 1e-12 of the rig size)."""
+    scale = rig_scale(rig)
+    d = np.zeros(3)
+    for _ in range(60):
+        span = d - centres
+        dist = np.linalg.norm(span, axis=1)
+        err = dist - radii
+        if np.abs(err).max() <= 1e-13 * scale:
+            return d
+        jac = span / dist[:, None]
+        d = d - np.linalg.pinv(jac) @ err
+    if np.abs(np.linalg.norm(d - centres, axis=1) - radii).max() <= 1e-12 * scale:
+        return d
+    raise _no_taut_pose(rig)
+
+
 def initial_state(rig: Rig, rest: Rest | None = None) -> State:
     """The rig's initial state, exactly as the rig file's ``[initial]`` table defines it."""
     rest = rest_pose(rig) if rest is None else rest
@@ -281,7 +368,9 @@ def initial_state(rig: Rig, rest: Rest | None = None) -> State:
     try:
         com = rest.com + taut_shift(rig, rest.com, rotation)
     except RigError as exc:
-        raise RigError(rig.source, "initial.rotation", exc.problem) from None
+        # Only a rotation can make the wires unreachable: the rest pose holds every wire taut.
+        field = "initial.rotation" if np.any(rig.initial_rotation != 0.0) else "wire"
+        raise RigError(rig.source, field, exc.problem) from None
     omega = np.asarray(rig.initial_omega, dtype=float)
     pts = attachments(rig, com, rotation)
     span = pts - anchors(rig)
@@ -289,4 +378,9 @@ def initial_state(rig: Rig, rest: Rest | None = None) -> State:
     # Wire i keeps its length iff dirs_i . (v + omega x arm_i) = 0; take the least-norm v.
     rate = np.einsum("ij,ij->i", dirs, np.cross(omega, pts - com))
     velocity = -np.linalg.pinv(dirs) @ rate
+    miss = np.abs(dirs @ velocity + rate).max()
+    # More wires than the COM velocity can satisfy; 1e-9 of the attachments' speed is rounding.
+    if miss > 1e-9 * np.linalg.norm(omega) * np.linalg.norm(pts - com, axis=1).max():
+        raise RigError(rig.source, "initial.omega", f"no COM velocity keeps every wire at its length "
+                       f"(mismatch {miss:.3g} m/s): this spin stretches a wire")
     return State(com=com, rotation=rotation, velocity=velocity, omega=omega)

@@ -36,6 +36,6 @@ class EngineInputError(ValueError):
 def engines() -> dict[str, EngineRun]:
     """Engine name -> run function (imported lazily so that one engine's import cost is paid only
     when it is used)."""
-    from . import kane, mujoco_rig
+    from . import kane, mujoco_rig, nwire
 
-    return {"kane": kane.run, **mujoco_rig.ENGINES}
+    return {"kane": kane.run, "nwire": nwire.run, **mujoco_rig.ENGINES}

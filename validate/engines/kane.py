@@ -1,4 +1,5 @@
-"""The hand-derived Kane-Tseng model as an engine (:mod:`bifilar.simulate`)."""
+"""The hand-derived models as the ``kane`` engine: Kane-Tseng (:mod:`bifilar.motion.simulate`) for two
+wires, the N-wire model (:mod:`bifilar.motion.nwire`) for three or more."""
 
 from __future__ import annotations
 
@@ -10,12 +11,16 @@ from bifilar.motion.simulate import Budget, KaneRun, simulate
 from bifilar.rig.statics import State, initial_state
 
 from ..trajectory import Trajectory, rig_quaternions
+from . import nwire
 
 
 def run(rig: Rig, duration: float, dt_out: float = 0.01, rtol: float = 1e-10, state: State | None = None, *,
         max_seconds: float | None = None) -> Trajectory:
     """Integrate from ``state`` (default: the rig's initial state) within the default work budget and
-    ``max_seconds`` of wall time; see :func:`bifilar.motion.simulate.simulate`."""
+    ``max_seconds`` of wall time; see :func:`bifilar.motion.simulate.simulate` (two wires) and
+    :func:`bifilar.motion.nwire.simulate` (more)."""
+    if len(rig.wires) != 2:
+        return nwire.run(rig, duration, dt_out, rtol, state, engine="kane", max_seconds=max_seconds)
     model = KaneModel.from_rig(rig)
     start = initial_state(rig) if state is None else state
     run = simulate(model, start, duration, dt_out=dt_out, rtol=rtol, budget=Budget(seconds=max_seconds))

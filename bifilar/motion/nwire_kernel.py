@@ -1,0 +1,132 @@
+"""Compiled Newton-Euler equations of a rigid body on N inextensible wires, tensions as multipliers.
+
+State y (13): COM c (world, m), unit quaternion q of the body->world rotation (scalar first), COM
+velocity v (world, m/s), angular velocity omega (world, rad/s). Per wire i: anchor a_i (world), arm
+s_i = R r_i (r_i: attachment minus COM, body frame), span d_i = a_i - c - s_i, length rho_i = |d_i|,
+direction u_i = d_i / rho_i and attachment velocity w_i = v + omega x s_i.
+
+With nu = (v, omega) and M = diag(m I, I_w), I_w = R I_b R^T, the equations are (docs/nwire-model.md):
+
+    M nu' = f - J^T t,     f = (-m g e_z, -omega x I_w omega),     J_i = [-u_i^T, (u_i x s_i)^T],
+    J nu' = b,             b_i = u_i . (omega x (omega x s_i)) - (|w_i|^2 - (u_i . w_i)^2) / rho_i,
+
+the second being rho_i'' = 0. Eliminating nu' gives the tensions from (J M^-1 J^T) t = J M^-1 f - b.
+Nothing here is shared with the statics (bifilar.rig.pose_kernel): the geometry is recomputed from
+its definition so the model is an independent check of the rest pose and the modes.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+STATE_SIZE = 13
+
+
+@njit(cache=True)
+def quat_matrix(q):
+    """Rotation matrix of a quaternion (scalar first), normalised first."""
+    n = np.sqrt(q @ q)
+    w, x, y, z = q[0] / n, q[1] / n, q[2] / n, q[3] / n
+    return np.array([
+        [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+        [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+        [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)],
+    ])
+
+
+@njit(cache=True)
+def _cross(a, b):
+    return np.array([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
+
+
+@njit(cache=True)
+def dynamics(y, arms, anchors, inertia_body, mass, gravity):
+    """(nu', tensions, J, rho): accelerations (v', omega'), wire tensions (N, positive pulling),
+    the constraint Jacobian (N x 6) and the anchor-attachment distances (m) at state y."""
+    n = arms.shape[0]
+    c, v, om = y[0:3], y[7:10], y[10:13]
+    rot = quat_matrix(y[3:7])
+    iw = rot @ inertia_body @ rot.T
+    iw_inv = rot @ np.linalg.inv(inertia_body) @ rot.T
+    jac = np.empty((n, 6))
+    b = np.empty(n)
+    rho = np.empty(n)
+    for i in range(n):
+        s = rot @ arms[i]
+        d = anchors[i] - c - s
+        rho[i] = np.sqrt(d @ d)
+        u = d / rho[i]
+        w = v + _cross(om, s)
+        uw = u @ w
+        jac[i, :3] = -u
+        jac[i, 3:] = _cross(u, s)
+        b[i] = u @ _cross(om, _cross(om, s)) - (w @ w - uw * uw) / rho[i]
+    f = np.zeros(6)
+    f[2] = -mass * gravity
+    f[3:] = -_cross(om, iw @ om)
+    # M^-1 applied to f and to each row of J (as columns of M^-1 J^T).
+    minv_f = np.empty(6)
+    minv_f[:3] = f[:3] / mass
+    minv_f[3:] = iw_inv @ f[3:]
+    minv_jt = np.empty((6, n))
+    for i in range(n):
+        minv_jt[:3, i] = jac[i, :3] / mass
+        minv_jt[3:, i] = iw_inv @ jac[i, 3:]
+    tension = np.linalg.solve(jac @ minv_jt, jac @ minv_f - b)
+    acc = minv_f - minv_jt @ tension
+    return acc, tension, jac, rho
+
+
+@njit(cache=True)
+def dynamics_jacobian(y, arms, anchors):
+    """The constraint Jacobian J (N x 6, rows [-u_i, u_i x s_i]) at state y."""
+    n = arms.shape[0]
+    rot = quat_matrix(y[3:7])
+    jac = np.empty((n, 6))
+    for i in range(n):
+        s = rot @ arms[i]
+        d = anchors[i] - y[0:3] - s
+        u = d / np.sqrt(d @ d)
+        jac[i, :3] = -u
+        jac[i, 3:] = _cross(u, s)
+    return jac
+
+
+@njit(cache=True)
+def rhs(y, arms, anchors, inertia_body, mass, gravity):
+    """y' for the state layout of the module docstring; q' = (1/2) (0, omega) * q (world omega)."""
+    acc = dynamics(y, arms, anchors, inertia_body, mass, gravity)[0]
+    q, om = y[3:7], y[10:13]
+    dy = np.empty(STATE_SIZE)
+    dy[0:3] = y[7:10]
+    dy[3] = -0.5 * (om[0] * q[1] + om[1] * q[2] + om[2] * q[3])
+    dy[4] = 0.5 * (om[0] * q[0] + om[1] * q[3] - om[2] * q[2])
+    dy[5] = 0.5 * (-om[0] * q[3] + om[1] * q[0] + om[2] * q[1])
+    dy[6] = 0.5 * (om[0] * q[2] - om[1] * q[1] + om[2] * q[0])
+    dy[7:13] = acc
+    return dy
+
+
+@njit(cache=True)
+def tensions(y, arms, anchors, inertia_body, mass, gravity):
+    """Wire tensions (N) at state y."""
+    return dynamics(y, arms, anchors, inertia_body, mass, gravity)[1]
+
+
+@njit(cache=True)
+def observe(Y, arms, anchors, inertia_body, mass, gravity):
+    """Per sample: the rotation matrix, the tensions (N) and the energy (J; potential zero at z = 0)."""
+    n_s, n = Y.shape[0], arms.shape[0]
+    frames = np.empty((n_s, 3, 3))
+    ten = np.empty((n_s, n))
+    energy = np.empty(n_s)
+    for k in range(n_s):
+        y = Y[k]
+        rot = quat_matrix(y[3:7])
+        frames[k] = rot
+        ten[k] = dynamics(y, arms, anchors, inertia_body, mass, gravity)[1]
+        om, v = y[10:13], y[7:10]
+        iw = rot @ inertia_body @ rot.T
+        energy[k] = 0.5 * mass * (v @ v) + 0.5 * (om @ (iw @ om)) + mass * gravity * y[2]
+    return frames, ten, energy
