@@ -3,14 +3,18 @@
 World frame z up. "Span" axes move the two points of a pair symmetrically about their midpoint along
 the line that joins them (the pair: the two anchors, or the two attachments, of wires 1 and 2), so the
 midpoint and the direction are the base rig's; "height" axes move along world z (anchors) or body z
-(attachments). Every axis acts on wires 1 and 2, the pair that defines a bifilar rig.
+(attachments). The span and height axes act on wires 1 and 2, the pair that defines a bifilar rig;
+``wire_length`` and ``platform_radius`` act on every wire (a trifilar platform's axes).
 
-- ``wire_length``: both wires' lengths (m).
+- ``wire_length``: every wire's length (m).
 - ``wire_length_2``: wire 2's length alone (m), for unequal wires; applied after ``wire_length``.
 - ``anchor_span``: the distance between the two ceiling anchors (m).
 - ``attach_span``: the distance between the two attachments (m), in the body frame.
 - ``attach_height``: both attachments' body-frame z (m).
 - ``anchor_height_difference``: anchor 2's world z minus anchor 1's (m), about their mean height.
+- ``platform_radius``: every attachment at this horizontal distance (m) from the body-frame vertical
+  through the attachments' centroid, and every anchor at it from the world vertical through the
+  anchors' centroid, each along its own direction (vertical wires stay vertical).
 """
 
 from __future__ import annotations
@@ -38,7 +42,7 @@ def _span(a: np.ndarray, b: np.ndarray, span: float) -> tuple[np.ndarray, np.nda
 
 
 def wire_length(rig: Rig, value: float) -> Rig:
-    return _wires(rig, w0={"length": value}, w1={"length": value})
+    return replace(rig, wires=tuple(replace(w, length=value) for w in rig.wires))
 
 
 def wire_length_2(rig: Rig, value: float) -> Rig:
@@ -68,6 +72,22 @@ def anchor_height_difference(rig: Rig, value: float) -> Rig:
     return _wires(rig, w0={"anchor": a}, w1={"anchor": b})
 
 
+def _radial(points: np.ndarray, radius: float) -> np.ndarray:
+    centre = points.mean(axis=0)
+    arm = points - centre
+    arm[:, 2] = 0.0
+    norm = np.linalg.norm(arm, axis=1)
+    if norm.min() <= 0.0:
+        raise ValueError("a point on the platform's axis has no radial direction")
+    return centre + np.column_stack([arm[:, :2] * (radius / norm)[:, None], points[:, 2] - centre[2]])
+
+
+def platform_radius(rig: Rig, value: float) -> Rig:
+    attach = _radial(np.array([w.attach for w in rig.wires]), value)
+    anchor = _radial(np.array([w.anchor for w in rig.wires]), value)
+    return replace(rig, wires=tuple(replace(w, attach=a, anchor=b) for w, a, b in zip(rig.wires, attach, anchor)))
+
+
 # Application order: lengths first so that wire_length_2 overrides wire 2's share of wire_length.
 AXES = {
     "wire_length": wire_length,
@@ -76,9 +96,10 @@ AXES = {
     "attach_span": attach_span,
     "attach_height": attach_height,
     "anchor_height_difference": anchor_height_difference,
+    "platform_radius": platform_radius,
 }
 # Axes whose values are distances that must be positive.
-POSITIVE = {"wire_length", "wire_length_2", "anchor_span", "attach_span"}
+POSITIVE = {"wire_length", "wire_length_2", "anchor_span", "attach_span", "platform_radius"}
 
 
 def configure(rig: Rig, values: dict[str, float]) -> Rig:
