@@ -172,3 +172,20 @@ def test_unreachable_points_inside_a_valid_grid_are_infeasible_rows(tmp_path):
                             '[measure]\naxes = ["z"]\n')
     rows = sweep_run.run(str(path), load_space(path), tmp_path / "o", jobs=1)
     assert [r["feasible"] for r in rows] == [True, False] and "no taut pose" in rows[1]["reason"]
+
+
+def test_trifilar_axes_move_every_wire(tmp_path):
+    """platform_radius and wire_length on the three-wire platform: the yaw period of every row is the
+    closed form 2 pi sqrt(L I / (M g R^2)) of vertical wires (exact in the linear limit)."""
+    from validate.assets import MODELS
+
+    rig = (MODELS / "rigs" / "trifilar.toml").read_text() + "\n[uncertainty]\nlength = 1e-3\nmass = 1e-3\nperiod = 1e-3\n"
+    path = _write(tmp_path, 'rig = "rig.toml"\n[vary]\nplatform_radius = [0.2, 0.3]\nwire_length = [1.0, 2.0]\n'
+                            '[measure]\naxes = ["z"]\n', rig=rig)
+    space = load_space(path)
+    for values in space.points():
+        row = evaluate(space, values)
+        R, L = values["platform_radius"], values["wire_length"]
+        closed = 2 * np.pi * np.sqrt(L * 0.1225 / (2.0 * 9.81 * R**2))
+        yaw = [p for p, m in zip(row.periods, row.motions) if m == "yaw"]
+        assert yaw == pytest.approx([closed], rel=1e-10) and row.sigma["z"] > 0 and row.feasible
