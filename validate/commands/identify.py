@@ -36,26 +36,7 @@ import numpy as np
 
 from bifilar.rig import RigError, load_rig
 
-from ..argtypes import UsageError, positive_float, whole_number
-
-
-def non_negative_float(name: str):
-    """A finite number >= 0 (argparse type; one-line error naming the option)."""
-    import argparse
-
-    def parse(text: str) -> float:
-        try:
-            value = float(text)
-        except ValueError:
-            raise argparse.ArgumentTypeError(f"{name} must be a number, got {text!r}") from None
-        if not math.isfinite(value) or value < 0.0:
-            raise argparse.ArgumentTypeError(f"{name} must be a non-negative finite number, got {text!r}")
-        return value
-
-    return parse
-
-AXIS_INDEX = {"x": 0, "y": 1, "z": 2}
-WEAK_SENSITIVITY = 0.02  # d ln T / d ln I below this: the period barely depends on the moment
+from ..argtypes import UsageError, bounded_float, positive_float, whole_number
 
 
 def add_parser(subparsers) -> None:
@@ -77,7 +58,7 @@ def add_parser(subparsers) -> None:
     p.add_argument("--angle-unit", choices=("rad", "deg"), default="rad", help="angle (or rate) unit (default rad)")
     p.add_argument("--from", dest="start", type=float, metavar="S", help="use the record from this time, s")
     p.add_argument("--to", dest="end", type=float, metavar="S", help="use the record up to this time, s")
-    p.add_argument("--law-sigma", type=non_negative_float("--law-sigma"), default=None, metavar="F",
+    p.add_argument("--law-sigma", type=bounded_float("--law-sigma", 0.0, math.inf, ""), default=None, metavar="F",
                    help="relative std allowed for the real rig's amplitude law against the ideal one "
                         "(default 0.5; 0: the ideal law exactly)")
     p.add_argument("--tare", metavar="FIXTURE.toml", help="the fixture alone, to subtract")
