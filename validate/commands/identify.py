@@ -38,6 +38,9 @@ from bifilar.rig import RigError, load_rig
 
 from ..argtypes import UsageError, bounded_float, positive_float, whole_number
 
+AXIS_INDEX = {"x": 0, "y": 1, "z": 2}
+WEAK_SENSITIVITY = 0.02  # d ln T / d ln I below this: the period barely depends on the moment
+
 
 def add_parser(subparsers) -> None:
     """Register the ``identify`` subcommand on the CLI's subparsers."""
