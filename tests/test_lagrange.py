@@ -9,7 +9,6 @@ import pytest
 from scipy.integrate import solve_ivp
 
 from bifilar.motion import lagrange as L
-from bifilar.motion.kane import KaneModel
 from bifilar.motion.modes import linearize
 from bifilar.rig import RigError
 from validate.assets import rig

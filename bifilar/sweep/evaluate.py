@@ -54,14 +54,8 @@ class Row:
     sigma: dict | None = None  # axis -> relative sigma (None: not identifiable or not measured)
     dominant: dict | None = None  # axis -> the uncertainty group with the largest share
     separation: float = math.nan  # smallest relative gap between two mode periods
-    clearance: float = math.nan  # m above the floor (minus nothing: the margin is a limit)
+    clearance: float = math.nan  # m of the lowest point above the floor (the margin is a limit)
     rest: Rest | None = None
-
-    def objective(self, kind: str) -> float:
-        vals = [v for v in (self.sigma or {}).values() if v is not None]
-        if not self.feasible or not vals:
-            return math.inf
-        return max(vals) if kind == "worst" else float(np.mean(vals))
 
 
 def state_tensions(rig: Rig, com, rotation, velocity) -> np.ndarray:

@@ -11,7 +11,6 @@ from __future__ import annotations
 
 from dataclasses import replace
 
-import mujoco
 import numpy as np
 
 from bifilar.bodies.air import Air, added_inertia, added_mass_principal

@@ -23,7 +23,6 @@ import numpy as np
 from scipy.integrate import quad
 
 from bifilar.motion.modes import linearize
-from bifilar.rig.statics import initial_state
 
 from ..assets import rig
 from ..engines import engines

@@ -29,7 +29,6 @@ import numpy as np
 from bifilar.identification import identify as ident
 from bifilar.bodies.boat import Configuration, Suspension, attachment_forces, lowest_point
 from bifilar.identification.identify import Identified
-from bifilar.motion.kane import KaneModel
 from bifilar.motion.modes import linearize
 from bifilar.identification.propagation import Propagation, linear
 from bifilar.rig import Rig, RigError
