@@ -189,3 +189,23 @@ def test_trifilar_axes_move_every_wire(tmp_path):
         closed = 2 * np.pi * np.sqrt(L * 0.1225 / (2.0 * 9.81 * R**2))
         yaw = [p for p, m in zip(row.periods, row.motions) if m == "yaw"]
         assert yaw == pytest.approx([closed], rel=1e-10) and row.sigma["z"] > 0 and row.feasible
+
+
+def test_a_sweep_in_air_says_how_much_of_each_period_is_air(tmp_path):
+    """The foam wing's yaw (air 17.0 % of the measured yaw inertia, case air-wing-share): the sweep's
+    air share of the yaw period at the rig's own wire length is the share of the apparent moment,
+    I_A / (I + I_A), for this pure rotation, to the modes' coupling (1e-3)."""
+    from bifilar.bodies.air import added_inertia
+    from validate.assets import MODELS, rig as shipped
+
+    wing = shipped("foam_wing")
+    text = (MODELS / "rigs" / "foam_wing.toml").read_text()
+    if "[uncertainty]" not in text:
+        text += "\n[uncertainty]\nlength = 1e-3\nmass = 1e-3\nperiod = 1e-3\n"
+    path = _write(tmp_path, f'rig = "rig.toml"\n[vary]\nwire_length = [{wing.wires[0].length!r}]\n[measure]\naxes = ["z"]\n',
+                  rig=text)
+    row = sweep_run.run_chunk(str(path), 0, 1)[0]
+    own = wing.inertia[2, 2]
+    air = added_inertia(wing.air, wing.com, np.array([0.0, 0.0, 1.0]))
+    assert row["air_share"]["z"] == pytest.approx(air / (own + air), rel=1e-3)
+    assert row["air_share"]["x"] is None  # not measured

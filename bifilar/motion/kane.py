@@ -171,6 +171,15 @@ class KaneModel:
         return th[4], float(gamma @ np.asarray(dtheta14, dtype=float))
 
 
+def air_vector(rig: Rig) -> np.ndarray:
+    """A kernel parameter vector holding only the air entries, in the rig's own body axes (the
+    N-wire model's frame); all zero (no air) for a body in a vacuum."""
+    p = np.zeros(K.P_AIR_DRAG.stop)
+    if rig.air is not None:
+        _air_parameters(p, rig, np.eye(3))
+    return p
+
+
 def _air_parameters(p: np.ndarray, rig: Rig, frame: np.ndarray) -> None:
     """Fill the kernel's air entries: the added-mass tensor about the COM, the ellipsoid's centre
     and axes, all turned from the rig's body axes to the n~ frame (columns of ``frame``)."""

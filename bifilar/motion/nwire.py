@@ -21,6 +21,7 @@ from scipy.integrate import solve_ivp
 from scipy.spatial.transform import Rotation
 
 from bifilar.motion import nwire_kernel as NK
+from bifilar.motion.kane import air_vector
 from bifilar.motion.simulate import Budget, IntegrationError, Meter, output_grid
 from bifilar.rig import Rig
 from bifilar.rig.statics import State, check_determinate, length_errors
@@ -42,6 +43,7 @@ class NWireModel:
     inertia: np.ndarray  # about the COM, body axes (3 x 3, kg m^2)
     mass: float
     gravity: float
+    air: np.ndarray  # the air's added mass, ellipsoid and drag (bifilar.motion.kane.air_vector); zeros in a vacuum
 
     @classmethod
     def from_rig(cls, rig: Rig) -> "NWireModel":
@@ -53,11 +55,12 @@ class NWireModel:
             inertia=np.ascontiguousarray(rig.inertia, dtype=float),
             mass=float(rig.mass),
             gravity=float(rig.gravity),
+            air=air_vector(rig),
         )
 
     @property
     def args(self):
-        return self.arms, self.anchors, self.inertia, self.mass, self.gravity
+        return self.arms, self.anchors, self.inertia, self.mass, self.gravity, self.air
 
     @property
     def scale(self) -> float:

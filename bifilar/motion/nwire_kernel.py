@@ -20,6 +20,9 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from bifilar.motion.kane_kernel import P_AIR as AIR_FLAG
+from bifilar.motion.kane_kernel import air_terms
+
 STATE_SIZE = 13
 
 
@@ -41,9 +44,14 @@ def _cross(a, b):
 
 
 @njit(cache=True)
-def dynamics(y, arms, anchors, inertia_body, mass, gravity):
+def dynamics(y, arms, anchors, inertia_body, mass, gravity, air):
     """(nu', tensions, J, rho): accelerations (v', omega'), wire tensions (N, positive pulling),
-    the constraint Jacobian (N x 6) and the anchor-attachment distances (m) at state y."""
+    the constraint Jacobian (N x 6) and the anchor-attachment distances (m) at state y.
+
+    ``air``: the Kane kernel's parameter vector with its air entries filled in the rig's body frame
+    (:func:`bifilar.motion.kane.air_vector`); with air the fluid's added mass M_A,w joins the mass
+    matrix and its velocity terms and drag the applied wrench, exactly as in the Kane model
+    (``kane_kernel.air_terms``); in a vacuum the block-diagonal path below runs unchanged."""
     n = arms.shape[0]
     c, v, om = y[0:3], y[7:10], y[10:13]
     rot = quat_matrix(y[3:7])
@@ -65,14 +73,25 @@ def dynamics(y, arms, anchors, inertia_body, mass, gravity):
     f = np.zeros(6)
     f[2] = -mass * gravity
     f[3:] = -_cross(om, iw @ om)
-    # M^-1 applied to f and to each row of J (as columns of M^-1 J^T).
     minv_f = np.empty(6)
-    minv_f[:3] = f[:3] / mass
-    minv_f[3:] = iw_inv @ f[3:]
     minv_jt = np.empty((6, n))
-    for i in range(n):
-        minv_jt[:3, i] = jac[i, :3] / mass
-        minv_jt[3:, i] = iw_inv @ jac[i, 3:]
+    if air[AIR_FLAG] != 0.0:
+        maw, bias, drag = air_terms(rot, v, om, air)
+        m6 = maw.copy()
+        for k in range(3):
+            m6[k, k] += mass
+        m6[3:, 3:] += iw
+        f += drag - bias
+        m6_inv = np.linalg.inv(m6)
+        minv_f[:] = m6_inv @ f
+        minv_jt[:, :] = m6_inv @ jac.T
+    else:
+        # M^-1 applied to f and to each row of J (as columns of M^-1 J^T).
+        minv_f[:3] = f[:3] / mass
+        minv_f[3:] = iw_inv @ f[3:]
+        for i in range(n):
+            minv_jt[:3, i] = jac[i, :3] / mass
+            minv_jt[3:, i] = iw_inv @ jac[i, 3:]
     tension = np.linalg.solve(jac @ minv_jt, jac @ minv_f - b)
     acc = minv_f - minv_jt @ tension
     return acc, tension, jac, rho
@@ -94,9 +113,9 @@ def dynamics_jacobian(y, arms, anchors):
 
 
 @njit(cache=True)
-def rhs(y, arms, anchors, inertia_body, mass, gravity):
+def rhs(y, arms, anchors, inertia_body, mass, gravity, air):
     """y' for the state layout of the module docstring; q' = (1/2) (0, omega) * q (world omega)."""
-    acc = dynamics(y, arms, anchors, inertia_body, mass, gravity)[0]
+    acc = dynamics(y, arms, anchors, inertia_body, mass, gravity, air)[0]
     q, om = y[3:7], y[10:13]
     dy = np.empty(STATE_SIZE)
     dy[0:3] = y[7:10]
@@ -109,14 +128,15 @@ def rhs(y, arms, anchors, inertia_body, mass, gravity):
 
 
 @njit(cache=True)
-def tensions(y, arms, anchors, inertia_body, mass, gravity):
+def tensions(y, arms, anchors, inertia_body, mass, gravity, air):
     """Wire tensions (N) at state y."""
-    return dynamics(y, arms, anchors, inertia_body, mass, gravity)[1]
+    return dynamics(y, arms, anchors, inertia_body, mass, gravity, air)[1]
 
 
 @njit(cache=True)
-def observe(Y, arms, anchors, inertia_body, mass, gravity):
-    """Per sample: the rotation matrix, the tensions (N) and the energy (J; potential zero at z = 0)."""
+def observe(Y, arms, anchors, inertia_body, mass, gravity, air):
+    """Per sample: the rotation matrix, the tensions (N) and the energy (J; potential zero at z = 0;
+    with air, the fluid's kinetic energy included as in the Kane model)."""
     n_s, n = Y.shape[0], arms.shape[0]
     frames = np.empty((n_s, 3, 3))
     ten = np.empty((n_s, n))
@@ -125,8 +145,11 @@ def observe(Y, arms, anchors, inertia_body, mass, gravity):
         y = Y[k]
         rot = quat_matrix(y[3:7])
         frames[k] = rot
-        ten[k] = dynamics(y, arms, anchors, inertia_body, mass, gravity)[1]
+        ten[k] = dynamics(y, arms, anchors, inertia_body, mass, gravity, air)[1]
         om, v = y[10:13], y[7:10]
         iw = rot @ inertia_body @ rot.T
         energy[k] = 0.5 * mass * (v @ v) + 0.5 * (om @ (iw @ om)) + mass * gravity * y[2]
+        if air[AIR_FLAG] != 0.0:
+            x = np.concatenate((v, om))
+            energy[k] += 0.5 * (x @ (air_terms(rot, v, om, air)[0] @ x))
     return frames, ten, energy

@@ -17,6 +17,10 @@ with the peak velocity (there h, the centripetal part, is largest) and turns at 
 +-A shape with no velocity (there the first-order part is largest); the peak tension is the largest
 over these three states: exact at the bottom, first order at the turning points. The test checks it
 against the Kane model's simulated tensions.
+
+With ``[air]`` in the base rig the modes carry the air's added mass, and ``air_share`` says how much of
+each measured period is air: 1 - (T_vacuum / T)^2 of the measured mode, the air's share of the
+apparent moment for a pure rotation.
 """
 
 from __future__ import annotations
@@ -28,6 +32,7 @@ import numpy as np
 
 from bifilar.bodies.composite import equivalent_box
 from bifilar.identification import identify as ident
+from bifilar.identification.air import vacuum
 from bifilar.identification.propagation import linear_axes
 from bifilar.motion.modes import Modes, linearize
 from bifilar.rig import Rig, RigError
@@ -55,6 +60,7 @@ class Row:
     dominant: dict | None = None  # axis -> the uncertainty group with the largest share
     separation: float = math.nan  # smallest relative gap between two mode periods
     clearance: float = math.nan  # m of the lowest point above the floor (the margin is a limit)
+    air_share: dict | None = None  # axis -> 1 - (T_vacuum / T)^2 of its mode: the air's part (rigs with [air])
     rest: Rest | None = None
 
 
@@ -148,6 +154,13 @@ def evaluate(space: Space, values: dict[str, float], guess: Rest | None = None) 
         about = rest.rotation @ ident.axis_vector(axis)
         peaks.append(peak_tension(rig, lin, measured_mode(rig, lin, about), about, space.amplitude))
     row.tension_peak = float(np.nanmax(peaks))
+    if rig.air is not None:  # how much of each measured period is the air's added inertia
+        bare = vacuum(rig)
+        row.air_share = {}
+        for axis, b in bases.items():
+            p = ident.pencil(bare, axis, lin=linearize(bare, rest))
+            k, w2, _ = p.associated(p.moment0)
+            row.air_share[axis] = 1.0 - (2.0 * np.pi / np.sqrt(w2[k]) / b.period) ** 2
     limits = space.limits
     if limits.floor is not None:
         row.clearance = lowest_point(rig, rest) - limits.floor

@@ -38,6 +38,7 @@ def _plain(row: Row) -> dict:
         "sigma": {a: num((row.sigma or {}).get(a)) for a in AXES},
         "dominant": {a: (row.dominant or {}).get(a) for a in AXES},
         "separation": num(row.separation), "clearance": num(row.clearance),
+        "air_share": {a: num((row.air_share or {}).get(a)) for a in AXES},
     }
 
 
