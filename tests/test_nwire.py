@@ -87,3 +87,10 @@ def test_slack_stops_the_run_with_status_3(tmp_path, capsys):
     assert code == 3 and "went slack at t = 0.1065" in err and err.count("\n") == 1
     rows = out.read_text().splitlines()
     assert 10 <= len(rows) - 1 <= 12  # samples up to the slack time, 0.01 s apart
+
+
+def test_every_engine_is_a_simulate_choice(tmp_path):
+    """The CLI's --engine choices are the registry's engines, nwire included."""
+    from validate.engines import NAMES, engines
+
+    assert set(NAMES) == set(engines())

@@ -18,6 +18,7 @@ from pathlib import Path
 
 from bifilar.rig import RigError, load_rig
 
+from .engines import NAMES as ENGINE_NAMES
 from .argtypes import OneLineParser, UsageError, bounded_float, positive_float, whole_number
 from .commands import boat as boat_cli
 from .commands import identify as identify_cli
@@ -80,9 +81,10 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("simulate", help="simulate a rig and write the trajectory CSV", epilog=EPILOG)
     p.add_argument("rig", help="rig file (TOML); the run starts from its [initial] disturbance")
-    p.add_argument("--engine", default="kane", choices=("kane", "mujoco", "mujoco-eq"),
-                   help="kane: the hand-derived model (stops where a wire goes slack); mujoco: tendon cables "
-                        "that may go slack; mujoco-eq: equality cables (default: kane)")
+    p.add_argument("--engine", default="kane", choices=ENGINE_NAMES,
+                   help="kane: the hand-derived model (Kane-Tseng for two wires, the N-wire model otherwise; "
+                        "stops where a wire goes slack); nwire: the N-wire model on any rig; mujoco: tendon "
+                        "cables that may go slack; mujoco-eq: equality cables (default: kane)")
     p.add_argument("--duration", type=bounded_float("--duration", 0.0, MAX_DURATION, "s", low_open=True),
                    required=True, help=f"simulated time, s, > 0 and at most {MAX_DURATION:g}")
     p.add_argument("--dt-out", type=bounded_float("--dt-out", 0.0, 100.0, "s", low_open=True), default=0.01,

@@ -33,6 +33,9 @@ class EngineInputError(ValueError):
         super().__init__(message)
 
 
+NAMES = ("kane", "nwire", "mujoco", "mujoco-eq")  # the keys of engines(), known without importing them
+
+
 def engines() -> dict[str, EngineRun]:
     """Engine name -> run function (imported lazily so that one engine's import cost is paid only
     when it is used)."""
