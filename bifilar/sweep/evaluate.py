@@ -15,8 +15,9 @@ F the weight and the gyroscopic wrench, differentiating J q' = 0 gives
 the generalised force of wire i being -t_i grad g_i. In the linear mode the state passes the rest pose
 with the peak velocity (there h, the centripetal part, is largest) and turns at the displaced poses
 +-A shape with no velocity (there the first-order part is largest); the peak tension is the largest
-over these three states: exact at the bottom, first order at the turning points. The test checks it
-against the Kane model's simulated tensions.
+over these three states: exact at the bottom, first order at the turning points. The tensions of a
+state are the N-wire model's (:mod:`bifilar.motion.nwire`, which solves exactly this). The test checks
+the peak against the Kane model's simulated tensions.
 
 With ``[air]`` in the base rig the modes carry the air's added mass, and ``air_share`` says how much of
 each measured period is air: 1 - (T_vacuum / T)^2 of the measured mode, the air's share of the
@@ -38,7 +39,8 @@ from bifilar.motion.modes import Modes, linearize
 from bifilar.rig import Rig, RigError
 from bifilar.rig import pose_kernel as PK
 from bifilar.rig.file import check_reachable
-from bifilar.rig.statics import Rest, anchors, arms, rest_pose
+from bifilar.motion.nwire import NWireModel, state_vector
+from bifilar.rig.statics import Rest, State, rest_pose
 from bifilar.sweep.axes import configure
 from bifilar.sweep.space import Space
 
@@ -64,20 +66,6 @@ class Row:
     rest: Rest | None = None
 
 
-def state_tensions(rig: Rig, com, rotation, velocity) -> np.ndarray:
-    """Wire tensions (N) of the state (pose, velocity q' = (COM velocity, omega), world)."""
-    s, u, rho = PK.wire_geometry(np.asarray(com, float), np.asarray(rotation, float), arms(rig), anchors(rig))
-    jac = PK.constraint_jacobian(s, u)
-    inertia = rotation @ rig.inertia @ rotation.T
-    minv = np.zeros((6, 6))
-    minv[:3, :3] = np.eye(3) / rig.mass
-    minv[3:, 3:] = np.linalg.inv(inertia)
-    omega = velocity[3:]
-    force = np.concatenate([[0.0, 0.0, -rig.mass * rig.gravity], -np.cross(omega, inertia @ omega)])
-    h = np.array([velocity @ PK.constraint_hessian(s, u, rho, i) @ velocity for i in range(len(rig.wires))])
-    return np.linalg.solve(jac @ minv @ jac.T, jac @ minv @ force + h)
-
-
 def peak_tension(rig: Rig, lin: Modes, index: int, amplitude_about: np.ndarray, amplitude: float) -> float:
     """Largest wire tension (N) over the motion of mode ``index`` whose peak rotation about the world
     axis ``amplitude_about`` is ``amplitude`` (see the module docstring)."""
@@ -87,11 +75,15 @@ def peak_tension(rig: Rig, lin: Modes, index: int, amplitude_about: np.ndarray, 
         return math.nan
     shape = np.concatenate([mode.com, mode.rotation]) * (amplitude / turn)
     rest = lin.rest
-    peak = state_tensions(rig, rest.com, rest.rotation, shape * (2.0 * np.pi / mode.period)).max()
+    model = NWireModel.from_rig(rig)  # its tensions at a state are the formula above
+
+    def tensions(com, rotation, velocity):
+        return model.tensions(state_vector(State(com, rotation, velocity[:3], velocity[3:])))
+
+    peak = tensions(rest.com, rest.rotation, shape * (2.0 * np.pi / mode.period)).max()
     for sign in (1.0, -1.0):
-        com = rest.com + sign * shape[:3]
         rot = PK.rotation_vector_matrix(sign * shape[3:]) @ rest.rotation
-        peak = max(peak, state_tensions(rig, com, rot, np.zeros(6)).max())
+        peak = max(peak, tensions(rest.com + sign * shape[:3], rot, np.zeros(6)).max())
     return float(peak)
 
 
