@@ -151,7 +151,8 @@ def _stable(rig: Rig, rest: Rest) -> bool:
     )
     if z.shape[1] == 0:
         return True
-    w2 = np.linalg.eigvalsh(np.linalg.solve(np.linalg.cholesky(mr), np.linalg.solve(np.linalg.cholesky(mr), kr).T))
+    chol = np.linalg.cholesky(mr)  # omega^2 are the eigenvalues of L^-1 K L^-T, M = L L^T
+    w2 = np.linalg.eigvalsh(np.linalg.solve(chol, np.linalg.solve(chol, kr).T))
     return bool(w2.min() >= -_NEUTRAL_SLACK * max(abs(w2).max(), 1e-300))
 
 
