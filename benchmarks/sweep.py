@@ -4,7 +4,7 @@ poses shared by the three axes) and the per-configuration path (a rest-pose sear
 propagation per axis, as `identify` does for a single rig). CPU time of this process, on the bench-plate
 sweep (models/sweeps/bench_plate.toml), BLAS on one thread as in a sweep's workers.
 
-    python benchmarks/sweep.py [N]     # N configurations of each path (default 40)
+    python benchmarks/sweep.py [N]     # N configurations of each path (default 300)
 """
 
 from __future__ import annotations
@@ -26,7 +26,7 @@ from validate.assets import MODELS
 def main(n: int) -> None:
     space = load_space(MODELS / "sweeps" / "bench_plate.toml")
     points = list(space.points())[:n]
-    evaluate(space, points[0])  # compile and warm up
+    evaluate(space, points[1], evaluate(space, points[0]).rest)  # compile and warm up both paths
     start = time.process_time()
     guess = None
     for p in points:
@@ -48,4 +48,4 @@ def main(n: int) -> None:
 
 if __name__ == "__main__":
     with threadpool_limits(1):
-        main(int(sys.argv[1]) if len(sys.argv) > 1 else 40)
+        main(int(sys.argv[1]) if len(sys.argv) > 1 else 300)

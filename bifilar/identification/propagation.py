@@ -17,8 +17,9 @@ dJ/dx_i = -(d ln T/dx_i) / (d ln T/dJ): d ln T/dJ = s / J with s the inversion's
 (Hellmann-Feynman, exact), and d ln T/dx_i, the change of the associated mode's period at fixed J, by
 forward differences with steps of 1e-3 sigma per input (small against the scale on which the period
 curves, large against its ~1e-13 rounding); the period's own entry is dJ/dT = J / (s T). Each
-perturbed rig's rest pose is continued from the base pose by Newton's method and linearised once for
-every axis (:func:`linear_axes`). var J = sum_i (dJ/dx_i sigma_i)^2, the 95 % interval J +- 1.96 sigma,
+perturbed rig's rest pose is continued from the base pose and its mode's omega^2 taken as a Rayleigh
+quotient, shared by every axis and compiled (:mod:`bifilar.identification.slopes_kernel`); where the
+base equilibrium is singular, each perturbed rig is solved afresh (:func:`_slopes_resolved`). var J = sum_i (dJ/dx_i sigma_i)^2, the 95 % interval J +- 1.96 sigma,
 and the budget gives each group's share of the variance.
 
 Monte Carlo (:func:`monte_carlo`): the inputs drawn around their measured values and each draw
@@ -32,14 +33,17 @@ rig and period drawn from the stated uncertainties, and the fraction whose inter
 from __future__ import annotations
 
 from dataclasses import dataclass, fields, replace
+from functools import lru_cache
 
 import numpy as np
 from scipy.stats import norm
 
-from bifilar.identification.identify import invert_period, linear_period, moment, pencil
-from bifilar.motion.modes import linearize
+from bifilar.bodies.air import added_mass
+from bifilar.identification.identify import Identified, invert_period, linear_period, moment, pencil, with_moment
+from bifilar.identification.slopes_kernel import period_slopes
+from bifilar.motion.modes import Modes, linearize
 from bifilar.rig import Rig, Uncertainty, Wire
-from bifilar.rig.statics import Rest, rest_pose
+from bifilar.rig.statics import Rest, rest_pose, rig_scale
 
 GROUPS = tuple(f.name for f in fields(Uncertainty))
 LEVEL = 0.95
@@ -60,25 +64,26 @@ class Inputs:
 def inputs(rig: Rig, period: float, period_std: float) -> Inputs:
     """The rig's measured quantities and the period, with the rig file's standard deviations."""
     unc = rig.uncertainty
-    names, groups, values, std = [], [], [], []
+    names, groups = _layout(len(rig.wires))
+    per_group = {"length": unc.length, "anchor": unc.anchor, "attach": unc.attach, "mass": unc.mass,
+                 "com": unc.com, "period": period_std}
+    wires = [np.concatenate([[w.length], w.anchor, w.attach]) for w in rig.wires]
+    values = np.concatenate(wires + [[rig.mass], rig.com, [period]]).astype(float)
+    std = np.array([per_group[g] for g in groups], dtype=float)
+    return Inputs(names, groups, values, std)
 
-    def add(name, group, value, sigma):
-        names.append(name)
-        groups.append(group)
-        values.append(float(value))
-        std.append(float(sigma))
 
-    for i, w in enumerate(rig.wires, start=1):
-        add(f"wire[{i}].length", "length", w.length, unc.length)
-        for k in range(3):
-            add(f"wire[{i}].anchor[{k}]", "anchor", w.anchor[k], unc.anchor)
-        for k in range(3):
-            add(f"wire[{i}].attach[{k}]", "attach", w.attach[k], unc.attach)
-    add("body.mass", "mass", rig.mass, unc.mass)
-    for k in range(3):
-        add(f"body.com[{k}]", "com", rig.com[k], unc.com)
-    add("period", "period", period, period_std)
-    return Inputs(tuple(names), tuple(groups), np.array(values), np.array(std))
+@lru_cache(maxsize=None)
+def _layout(n_wires: int) -> tuple[tuple[str, ...], tuple[str, ...]]:
+    """Names and groups of the inputs of a rig with ``n_wires`` wires, in the order of :func:`inputs`."""
+    names, groups = [], []
+    for i in range(1, n_wires + 1):
+        names += [f"wire[{i}].length"] + [f"wire[{i}].anchor[{k}]" for k in range(3)]
+        names += [f"wire[{i}].attach[{k}]" for k in range(3)]
+        groups += ["length"] + ["anchor"] * 3 + ["attach"] * 3
+    names += ["body.mass"] + [f"body.com[{k}]" for k in range(3)] + ["period"]
+    groups += ["mass"] + ["com"] * 3 + ["period"]
+    return tuple(names), tuple(groups)
 
 
 def apply(rig: Rig, x: np.ndarray) -> tuple[Rig, float]:
@@ -112,8 +117,15 @@ class Propagation:
 def _budget(inp: Inputs, gradient: np.ndarray) -> dict[str, float]:
     parts = (gradient * inp.std) ** 2
     total = parts.sum()
-    groups = np.array(inp.groups)
-    return {g: float(parts[groups == g].sum() / total) if total > 0.0 else 0.0 for g in GROUPS}
+    shares = np.zeros(len(GROUPS))
+    np.add.at(shares, _group_index(inp.groups), parts)
+    return {g: float(shares[n] / total) if total > 0.0 else 0.0 for n, g in enumerate(GROUPS)}
+
+
+@lru_cache(maxsize=None)
+def _group_index(groups: tuple[str, ...]) -> np.ndarray:
+    """Index in :data:`GROUPS` of each input's group."""
+    return np.array([GROUPS.index(g) for g in groups])
 
 
 def linear(rig: Rig, axis, period: float, period_std: float, rest: Rest | None = None) -> Propagation:
@@ -122,15 +134,59 @@ def linear(rig: Rig, axis, period: float, period_std: float, rest: Rest | None =
     return linear_axes(rig, {axis: period}, period_std, rest)[axis]
 
 
-def linear_axes(rig: Rig, periods: dict, period_std: float, rest: Rest | None = None, bases: dict | None = None) -> dict:
+def linear_axes(rig: Rig, periods: dict, period_std: float, rest: Rest | None = None, bases: dict | None = None,
+                lin: Modes | None = None) -> dict:
     """:func:`linear` for several axes at once (axis -> measured period): the perturbed rigs' rest
-    poses and linearisations are shared, as the geometry inputs are the same for every axis.
-    ``bases``: the inversions (axis -> :class:`Identified`) if already known."""
+    poses are shared, as the geometry inputs are the same for every axis. ``bases``: the inversions
+    (axis -> :class:`Identified`) and ``lin``: the rig's linearisation about ``rest``, if known."""
     rest = rest_pose(rig) if rest is None else rest
+    lin = linearize(rig, rest) if lin is None else lin
+    pencils = {a: pencil(rig, a, lin=lin) for a in periods}
     if bases is None:
-        bases = {a: invert_period(rig, a, t, rest) for a, t in periods.items()}
+        bases = {a: invert_period(rig, a, t, rest, pencils[a]) for a, t in periods.items()}
     inp = inputs(rig, 0.0, period_std)
-    slopes = {a: np.zeros(len(inp.values)) for a in periods}  # d ln T / d x_i at fixed J
+    axes = list(bases)
+    shapes, inertias = np.empty((len(axes), 6)), np.empty((len(axes), 3, 3))
+    for n, a in enumerate(axes):
+        k, _, v = pencils[a].associated(bases[a].moment)
+        shapes[n] = lin.basis @ v[:, k]
+        inertias[n] = with_moment(rig, a, bases[a].moment).inertia
+    table, ok = kernel_slopes(rig, rest, inp, shapes, inertias)
+    slopes = {a: table[n] for n, a in enumerate(axes)} if ok else _slopes_resolved(rig, rest, inp, bases)
+    return {a: propagate(b, slopes[a], inputs(b.rig, periods[a], period_std)) for a, b in bases.items()}
+
+
+def propagate(base: Identified, slopes: np.ndarray, own: Inputs) -> Propagation:
+    """The linear propagation for one axis from d ln T / d x_i at fixed J (``slopes``, the period's
+    entry unused) and the inputs ``own`` of the identified rig with its measured period."""
+    dlnT_dJ = base.sensitivity / base.moment
+    gradient = -slopes / dlnT_dJ
+    gradient[-1] = 1.0 / (base.period * dlnT_dJ)  # dJ / dT of the measured period
+    gradient = np.where(own.std > 0.0, gradient, 0.0)
+    std = float(np.sqrt(np.sum((gradient * own.std) ** 2)))
+    return Propagation(base.moment, std, base.moment - _Z * std, base.moment + _Z * std, "linear",
+                       _budget(own, gradient), own, gradient)
+
+
+def kernel_slopes(rig: Rig, rest: Rest, inp: Inputs, shapes: np.ndarray, inertias: np.ndarray):
+    """(table axes x inputs, ok): d ln T / d x_i at fixed J of the modes with pose shapes ``shapes`` at
+    the inertias ``inertias``, compiled (:func:`bifilar.identification.slopes_kernel.period_slopes`); ok is
+    False where the rest pose does not continue uniquely (then :func:`_slopes_resolved` is the path)."""
+    h = _STEP * inp.std
+    h[-1] = 0.0
+    air_base, air_com = np.zeros((6, 6)), np.zeros((3, 6, 6))
+    if rig.air is not None:
+        air_base = added_mass(rig.air, rig.com)
+        for k in range(3):
+            air_com[k] = added_mass(rig.air, rig.com + h[-4 + k] * np.eye(3)[k])
+    return period_slopes(inp.values, h, len(rig.wires), float(rig.gravity), rig_scale(rig), rest.com,
+                         rest.rotation, rest.tensions, inertias, shapes, air_base, air_com)
+
+
+def _slopes_resolved(rig: Rig, rest: Rest, inp: Inputs, bases: dict) -> dict:
+    """The slopes of :func:`kernel_slopes` with each changed rig's rest pose found by :func:`rest_pose` (from the base
+    pose) and its modes solved afresh: the general path, for a singular base equilibrium."""
+    slopes = {a: np.zeros(len(inp.values)) for a in bases}
     for i in np.flatnonzero(inp.std[:-1] > 0.0):
         x = inp.values.copy()
         h = _STEP * inp.std[i]
@@ -141,17 +197,7 @@ def linear_axes(rig: Rig, periods: dict, period_std: float, rest: Rest | None = 
             p = pencil(changed, a, lin=lin)
             k, w2, _ = p.associated(b.moment)
             slopes[a][i] = (np.log(2.0 * np.pi / np.sqrt(w2[k])) - np.log(b.period)) / h
-    out = {}
-    for a, b in bases.items():
-        dlnT_dJ = b.sensitivity / b.moment
-        gradient = -slopes[a] / dlnT_dJ
-        gradient[-1] = 1.0 / (b.period * dlnT_dJ)  # dJ / dT of the measured period
-        own = inputs(b.rig, periods[a], period_std)
-        gradient = np.where(own.std > 0.0, gradient, 0.0)
-        std = float(np.sqrt(np.sum((gradient * own.std) ** 2)))
-        out[a] = Propagation(b.moment, std, b.moment - _Z * std, b.moment + _Z * std, "linear",
-                             _budget(own, gradient), own, gradient)
-    return out
+    return slopes
 
 
 def monte_carlo(rig: Rig, axis, period: float, period_std: float, samples: int, rng: np.random.Generator) -> Propagation:

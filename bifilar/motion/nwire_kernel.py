@@ -39,6 +39,29 @@ def quat_matrix(q):
 
 
 @njit(cache=True)
+def matrix_quat(rot):
+    """The unit quaternion (scalar first, w >= 0) of a rotation matrix (Shepperd's method: the
+    largest of the four squared components is taken first, so no division is by a small number)."""
+    tr = rot[0, 0] + rot[1, 1] + rot[2, 2]
+    q = np.empty(4)
+    if tr >= max(rot[0, 0], rot[1, 1], rot[2, 2]):
+        r = np.sqrt(1.0 + tr)
+        q[0], q[1] = 0.5 * r, (rot[2, 1] - rot[1, 2]) / (2.0 * r)
+        q[2], q[3] = (rot[0, 2] - rot[2, 0]) / (2.0 * r), (rot[1, 0] - rot[0, 1]) / (2.0 * r)
+    else:
+        i = 0 if rot[0, 0] >= max(rot[1, 1], rot[2, 2]) else (1 if rot[1, 1] >= rot[2, 2] else 2)
+        j, k = (i + 1) % 3, (i + 2) % 3
+        r = np.sqrt(1.0 + rot[i, i] - rot[j, j] - rot[k, k])
+        q[1 + i] = 0.5 * r
+        q[0] = (rot[k, j] - rot[j, k]) / (2.0 * r)
+        q[1 + j] = (rot[j, i] + rot[i, j]) / (2.0 * r)
+        q[1 + k] = (rot[k, i] + rot[i, k]) / (2.0 * r)
+    if q[0] < 0.0:
+        q = -q
+    return q
+
+
+@njit(cache=True)
 def _cross(a, b):
     return np.array([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
 

@@ -40,25 +40,35 @@ def cross_matrix(v):
 @nb.njit(cache=True)
 def rotation_vector_matrix(theta):
     """exp([theta]x) by Rodrigues' formula (series near zero)."""
-    angle = np.sqrt(theta @ theta)
+    angle = np.sqrt(theta[0] ** 2 + theta[1] ** 2 + theta[2] ** 2)
     k = cross_matrix(theta)
     if angle < 1e-8:
-        return np.eye(3) + k + 0.5 * (k @ k)
-    return np.eye(3) + (np.sin(angle) / angle) * k + ((1.0 - np.cos(angle)) / angle**2) * (k @ k)
+        a, b = 1.0, 0.5
+    else:
+        a, b = np.sin(angle) / angle, (1.0 - np.cos(angle)) / angle**2
+    out = np.empty((3, 3))
+    for r in range(3):
+        for c in range(3):
+            kk = k[r, 0] * k[0, c] + k[r, 1] * k[1, c] + k[r, 2] * k[2, c]
+            out[r, c] = (1.0 if r == c else 0.0) + a * k[r, c] + b * kk
+    return out
 
 
 @nb.njit(cache=True)
 def wire_geometry(com, rot, arms, anchors):
-    """Per wire: arm s_i = R r_i (world), direction u_i to the anchor and distance rho_i."""
+    """Per wire: arm s_i = R r_i (world), direction u_i to the anchor and distance rho_i (written out:
+    these 3-vectors are too small for BLAS calls to pay)."""
     n = arms.shape[0]
     s = np.empty((n, 3))
     u = np.empty((n, 3))
     rho = np.empty(n)
     for i in range(n):
-        s[i] = rot @ arms[i]
-        d = anchors[i] - com - s[i]
-        rho[i] = np.sqrt(d @ d)
-        u[i] = d / rho[i]
+        for r in range(3):
+            s[i, r] = rot[r, 0] * arms[i, 0] + rot[r, 1] * arms[i, 1] + rot[r, 2] * arms[i, 2]
+            u[i, r] = anchors[i, r] - com[r] - s[i, r]
+        rho[i] = np.sqrt(u[i, 0] ** 2 + u[i, 1] ** 2 + u[i, 2] ** 2)
+        for r in range(3):
+            u[i, r] /= rho[i]
     return s, u, rho
 
 
@@ -68,21 +78,65 @@ def constraint_jacobian(s, u):
     n = s.shape[0]
     jac = np.empty((n, 6))
     for i in range(n):
-        jac[i, :3] = -u[i]
-        jac[i, 3:] = np.cross(u[i], s[i])
+        jac[i, 0], jac[i, 1], jac[i, 2] = -u[i, 0], -u[i, 1], -u[i, 2]
+        jac[i, 3] = u[i, 1] * s[i, 2] - u[i, 2] * s[i, 1]
+        jac[i, 4] = u[i, 2] * s[i, 0] - u[i, 0] * s[i, 2]
+        jac[i, 5] = u[i, 0] * s[i, 1] - u[i, 1] * s[i, 0]
     return jac
 
 
 @nb.njit(cache=True)
 def constraint_hessian(s, u, rho, i):
-    """hess g_i in q = (x, theta) at q = 0 (6 x 6, symmetric)."""
-    proj = np.eye(3) - np.outer(u[i], u[i])
-    pmat = np.zeros((3, 6))
-    pmat[:, :3] = np.eye(3)
-    pmat[:, 3:] = -cross_matrix(s[i])
-    h = pmat.T @ proj @ pmat / rho[i]
-    h[3:, 3:] -= 0.5 * (np.outer(u[i], s[i]) + np.outer(s[i], u[i])) - (u[i] @ s[i]) * np.eye(3)
+    """hess g_i in q = (x, theta) at q = 0 (6 x 6, symmetric), written out in blocks:
+    with A = (I - u u^T) / rho and S = [s]x, P^T A P = [[A, -A S], [S A, -S A S]]."""
+    a = -np.outer(u[i], u[i]) / rho[i]
+    for k in range(3):
+        a[k, k] += 1.0 / rho[i]
+    sx = cross_matrix(s[i])
+    a_s = np.zeros((3, 3))
+    s_a_s = np.zeros((3, 3))
+    for r in range(3):
+        for c in range(3):
+            for k in range(3):
+                a_s[r, c] += a[r, k] * sx[k, c]
+    for r in range(3):
+        for c in range(3):
+            for k in range(3):
+                s_a_s[r, c] += sx[r, k] * a_s[k, c]
+    us = u[i, 0] * s[i, 0] + u[i, 1] * s[i, 1] + u[i, 2] * s[i, 2]
+    h = np.empty((6, 6))
+    for r in range(3):
+        for c in range(3):
+            h[r, c] = a[r, c]
+            h[r, 3 + c] = -a_s[r, c]
+            h[3 + c, r] = -a_s[r, c]  # (S A)^T = -A S: S A = (-A S)^T
+            h[3 + r, 3 + c] = -s_a_s[r, c] - 0.5 * (u[i, r] * s[i, c] + s[i, r] * u[i, c])
+        h[3 + r, 3 + r] += us
     return h
+
+
+@nb.njit(cache=True)
+def equilibrium_balance(com, rot, tensions, arms, anchors, lengths, weight, scale):
+    """The residual of :func:`equilibrium_residual` alone (6 + N), without its Jacobian."""
+    n = arms.shape[0]
+    res = np.zeros(6 + n)
+    res[2] = -1.0
+    for i in range(n):
+        t = tensions[i] / weight
+        s0 = rot[0, 0] * arms[i, 0] + rot[0, 1] * arms[i, 1] + rot[0, 2] * arms[i, 2]
+        s1 = rot[1, 0] * arms[i, 0] + rot[1, 1] * arms[i, 1] + rot[1, 2] * arms[i, 2]
+        s2 = rot[2, 0] * arms[i, 0] + rot[2, 1] * arms[i, 1] + rot[2, 2] * arms[i, 2]
+        d0, d1, d2 = anchors[i, 0] - com[0] - s0, anchors[i, 1] - com[1] - s1, anchors[i, 2] - com[2] - s2
+        rho = np.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
+        u0, u1, u2 = d0 / rho, d1 / rho, d2 / rho
+        res[0] += t * u0
+        res[1] += t * u1
+        res[2] += t * u2
+        res[3] += t * (s1 * u2 - s2 * u1) / scale
+        res[4] += t * (s2 * u0 - s0 * u2) / scale
+        res[5] += t * (s0 * u1 - s1 * u0) / scale
+        res[6 + i] = (rho - lengths[i]) / scale
+    return res
 
 
 @nb.njit(cache=True)
@@ -91,14 +145,10 @@ def equilibrium_residual(com, rot, tensions, arms, anchors, lengths, weight, sca
     (6 + N), and its Jacobian with respect to (x, theta, t / W)."""
     n = arms.shape[0]
     s, u, rho = wire_geometry(com, rot, arms, anchors)
-    res = np.zeros(6 + n)
+    res = equilibrium_balance(com, rot, tensions, arms, anchors, lengths, weight, scale)
     jac = np.zeros((6 + n, 6 + n))
-    res[2] = -1.0
     for i in range(n):
         t = tensions[i] / weight
-        res[:3] += t * u[i]
-        res[3:6] += t * np.cross(s[i], u[i]) / scale
-        res[6 + i] = (rho[i] - lengths[i]) / scale
         # du = -(I - u u^T) / rho dp,  dp = dx - [s]x dtheta,  ds = dtheta x s = -[s]x dtheta
         proj = (np.eye(3) - np.outer(u[i], u[i])) / rho[i]
         sx = cross_matrix(s[i])

@@ -34,7 +34,7 @@ _RESIDUAL = 1e-12
 # Constraint rows whose singular value is below this fraction of the largest are dependent.
 NULL_RTOL = 1e-9
 # An omega^2 below -this fraction of the largest is a real instability, not rounding.
-_NEUTRAL_SLACK = 1e-9
+NEUTRAL_SLACK = 1e-9
 
 
 @dataclass(frozen=True)
@@ -153,7 +153,7 @@ def _stable(rig: Rig, rest: Rest) -> bool:
         return True
     chol = np.linalg.cholesky(mr)  # omega^2 are the eigenvalues of L^-1 K L^-T, M = L L^T
     w2 = np.linalg.eigvalsh(np.linalg.solve(chol, np.linalg.solve(chol, kr).T))
-    return bool(w2.min() >= -_NEUTRAL_SLACK * max(abs(w2).max(), 1e-300))
+    return bool(w2.min() >= -NEUTRAL_SLACK * max(abs(w2).max(), 1e-300))
 
 
 def _global_rest_pose(rig: Rig) -> Rest:

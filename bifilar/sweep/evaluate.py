@@ -28,19 +28,20 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
 
 from bifilar.bodies.composite import equivalent_box
 from bifilar.identification import identify as ident
 from bifilar.identification.air import vacuum
-from bifilar.identification.propagation import linear_axes
-from bifilar.motion.modes import Modes, linearize
+from bifilar.identification.propagation import inputs, kernel_slopes, linear_axes, propagate
+from bifilar.motion.modes import DEGENERATE_RTOL, NEUTRAL_RTOL, Modes, linearize, motion_of
+from bifilar.motion.nwire import NWireModel
 from bifilar.rig import Rig, RigError
-from bifilar.rig import pose_kernel as PK
 from bifilar.rig.file import check_reachable
-from bifilar.motion.nwire import NWireModel, state_vector
-from bifilar.rig.statics import Rest, State, rest_pose
+from bifilar.rig.statics import NEUTRAL_SLACK, NULL_RTOL, Rest, anchors, arms, lengths, rest_pose, rig_scale
+from bifilar.sweep import kernel as SK
 from bifilar.sweep.axes import configure
 from bifilar.sweep.space import Space
 
@@ -70,21 +71,24 @@ def peak_tension(rig: Rig, lin: Modes, index: int, amplitude_about: np.ndarray, 
     """Largest wire tension (N) over the motion of mode ``index`` whose peak rotation about the world
     axis ``amplitude_about`` is ``amplitude`` (see the module docstring)."""
     mode = lin.modes[index]
-    turn = abs(mode.rotation @ amplitude_about)
-    if mode.period is None or turn <= 0.0:
+    if mode.period is None:
         return math.nan
-    shape = np.concatenate([mode.com, mode.rotation]) * (amplitude / turn)
-    rest = lin.rest
     model = NWireModel.from_rig(rig)  # its tensions at a state are the formula above
+    return _peak(model, lin.rest, [np.concatenate([mode.com, mode.rotation])], [mode.period], [amplitude_about], amplitude)
 
-    def tensions(com, rotation, velocity):
-        return model.tensions(state_vector(State(com, rotation, velocity[:3], velocity[3:])))
 
-    peak = tensions(rest.com, rest.rotation, shape * (2.0 * np.pi / mode.period)).max()
-    for sign in (1.0, -1.0):
-        rot = PK.rotation_vector_matrix(sign * shape[3:]) @ rest.rotation
-        peak = max(peak, tensions(rest.com + sign * shape[:3], rot, np.zeros(6)).max())
-    return float(peak)
+def _peak(model: NWireModel, rest: Rest, shapes: list, periods: list, abouts: list, amplitude: float) -> float:
+    """:func:`peak_tension` over modes of any scale ``shapes`` (x, theta; world) with ``periods``, each
+    scaled to peak rotation ``amplitude`` about its world axis in ``abouts``."""
+    scaled, omegas = [], []
+    for shape, period, about in zip(shapes, periods, abouts):
+        turn = abs(shape[3:] @ about)
+        if turn > 0.0:
+            scaled.append(shape * (amplitude / turn))
+            omegas.append(2.0 * np.pi / period)
+    if not scaled:
+        return math.nan
+    return float(SK.peak_tension(rest.com, rest.rotation, np.array(scaled), np.array(omegas), *model.args))
 
 
 def measured_mode(rig: Rig, lin: Modes, about: np.ndarray) -> int:
@@ -104,24 +108,88 @@ def measured_mode(rig: Rig, lin: Modes, about: np.ndarray) -> int:
 
 def lowest_point(rig: Rig, rest: Rest) -> float:
     """World z (m) of the lowest corner of the body's inertia-equivalent box at rest."""
-    half, axes = equivalent_box(rig.mass, rig.inertia)
-    corners = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)]) * half
-    body = rig.com + corners @ axes.T
+    body = rig.com + _box_corners(float(rig.mass), *np.asarray(rig.inertia, dtype=float).ravel())
     world = rest.com + (body - rig.com) @ rest.rotation.T
     return float(world[:, 2].min())
 
 
+@lru_cache(maxsize=64)
+def _box_corners(mass: float, *inertia: float) -> np.ndarray:
+    """Corners (8 x 3, body frame, about the COM) of the inertia-equivalent box: one per body, not
+    one per configuration (a sweep varies the wires, not the body)."""
+    half, axes = equivalent_box(mass, np.array(inertia).reshape(3, 3))
+    corners = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)]) * half
+    return corners @ axes.T
+
+
 def evaluate(space: Space, values: dict[str, float], guess: Rest | None = None) -> Row:
-    """Evaluate one configuration; an unreachable one is a row marked infeasible, never an error."""
+    """Evaluate one configuration; an unreachable one is a row marked infeasible, never an error.
+
+    With ``guess`` (the neighbouring configuration's rest pose) the compiled continuation of
+    :mod:`bifilar.sweep.kernel` is tried first; the general path takes every configuration it
+    hands back, every first configuration of a chunk and every rig with ``[air]``."""
     row = Row(values=values)
     try:
         rig = configure(space.rig, values)
         check_reachable(rig)
-        rest = rest_pose(rig, guess)
-        lin = linearize(rig, rest)
+        if guess is None or rig.air is not None or not _continued(space, rig, row, guess):
+            _general(space, rig, row, guess)
     except (RigError, np.linalg.LinAlgError) as exc:
         row.reason = exc.problem if isinstance(exc, RigError) else f"singular: {exc}"
         return row
+    _limits(space, rig, row)
+    return row
+
+
+def _continued(space: Space, rig: Rig, row: Row, guess: Rest) -> bool:
+    """Fill ``row`` from the compiled continuation; False (row untouched) if it hands back."""
+    status, com, rot, tensions, w2, shapes = SK.continued_modes(
+        arms(rig), anchors(rig), lengths(rig), rig.mass, rig.gravity, rig.inertia, rig_scale(rig), guess.com,
+        guess.rotation, guess.tensions, NULL_RTOL, NEUTRAL_RTOL, DEGENERATE_RTOL, NEUTRAL_SLACK)
+    if status != SK.OK:
+        return False
+    rest = Rest(com, rot, tensions)
+    periods = 2.0 * np.pi / np.sqrt(w2)  # w2 ascending: the longest period first
+    row.rest = rest
+    row.tensions = tuple(float(t) for t in tensions[:2])
+    row.periods = tuple(([float(p) for p in periods] + [None] * 4)[:4])
+    row.motions = tuple(([motion_of(rig, rest, shapes[:3, k], shapes[3:, k]) for k in range(len(w2))] + [""] * 4)[:4])
+    row.separation = float(np.min((periods[:-1] - periods[1:]) / periods[:-1])) if len(w2) > 1 else math.nan
+    row.sigma, row.dominant = {}, {}
+    bases, chosen = {}, {}
+    for axis in space.measure:
+        about = rot @ ident.axis_vector(axis)
+        j0 = ident.moment(rig, axis)
+        shares = j0 * (about @ shapes[3:]) ** 2  # the pencil's shares: the shapes are M-normalised
+        if shares.max() < 1e-12:  # no mode turns about the axis
+            row.sigma[axis], row.dominant[axis] = None, None
+            continue
+        k = int(np.argmax(shares))
+        chosen[axis] = k
+        bases[axis] = ident.Identified(j0, float(periods[k]), float(0.5 * shares[k]), rig)
+    inp = inputs(rig, 0.0, rig.uncertainty.period)
+    table, ok = kernel_slopes(rig, rest, inp, np.array([shapes[:, k] for k in chosen.values()]).reshape(-1, 6),
+                              np.array([rig.inertia] * len(chosen)).reshape(-1, 3, 3))
+    if not ok:
+        return False
+    for n, (axis, k) in enumerate(chosen.items()):
+        _record(row, axis, propagate(bases[axis], table[n], inputs(rig, bases[axis].period, rig.uncertainty.period)))
+    peak = _peak(NWireModel.from_rig(rig), rest, [shapes[:, k] for k in chosen.values()],
+                 [periods[k] for k in chosen.values()], [rot @ ident.axis_vector(a) for a in chosen], space.amplitude)
+    row.tension_peak = float(np.nanmax([tensions.max(), peak]))
+    return True
+
+
+def _record(row: Row, axis: str, spread) -> None:
+    row.sigma[axis] = spread.std / spread.moment
+    row.dominant[axis] = max(spread.budget, key=spread.budget.get) if spread.std > 0.0 else None
+
+
+def _general(space: Space, rig: Rig, row: Row, guess: Rest | None) -> None:
+    """Fill ``row`` by the general path: :func:`rest_pose`, :func:`linearize`, the pencils and
+    :func:`linear_axes`, as ``identify`` and ``modes`` do."""
+    rest = rest_pose(rig, guess)
+    lin = linearize(rig, rest)
     row.rest = rest
     row.tensions = tuple(float(t) for t in rest.tensions[:2])
     periods = [m.period for m in lin.modes] + [None] * 4
@@ -139,10 +207,9 @@ def evaluate(space: Space, values: dict[str, float], guess: Rest | None = None) 
             continue
         bases[axis] = ident.predicted(rig, p)
     periods = {axis: b.period for axis, b in bases.items()}
-    spreads = linear_axes(rig, periods, rig.uncertainty.period, rest, bases)
+    spreads = linear_axes(rig, periods, rig.uncertainty.period, rest, bases, lin)
     for axis, spread in spreads.items():
-        row.sigma[axis] = spread.std / spread.moment
-        row.dominant[axis] = max(spread.budget, key=spread.budget.get) if spread.std > 0.0 else None
+        _record(row, axis, spread)
         about = rest.rotation @ ident.axis_vector(axis)
         peaks.append(peak_tension(rig, lin, measured_mode(rig, lin, about), about, space.amplitude))
     row.tension_peak = float(np.nanmax(peaks))
@@ -153,9 +220,13 @@ def evaluate(space: Space, values: dict[str, float], guess: Rest | None = None) 
             p = ident.pencil(bare, axis, lin=linearize(bare, rest))
             k, w2, _ = p.associated(p.moment0)
             row.air_share[axis] = 1.0 - (2.0 * np.pi / np.sqrt(w2[k]) / b.period) ** 2
+
+
+def _limits(space: Space, rig: Rig, row: Row) -> None:
+    """Clearance and the limits: ``row.feasible`` and the reasons it is not."""
     limits = space.limits
     if limits.floor is not None:
-        row.clearance = lowest_point(rig, rest) - limits.floor
+        row.clearance = lowest_point(rig, row.rest) - limits.floor
     problems = []
     if any(v is None for v in row.sigma.values()):
         problems.append("an axis cannot be identified")
@@ -165,4 +236,3 @@ def evaluate(space: Space, values: dict[str, float], guess: Rest | None = None) 
         problems.append(f"clearance {row.clearance:.4g} m under {limits.clearance:g} m")
     row.feasible = not problems
     row.reason = "; ".join(problems)
-    return row

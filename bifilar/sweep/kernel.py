@@ -1,0 +1,80 @@
+"""Compiled core of one sweep configuration, continued from its neighbour's rest pose.
+
+A sweep steps through neighbouring configurations, so each rest pose is a few Newton steps from the
+previous one. :func:`continued_modes` does those steps (:func:`bifilar.rig.pose_kernel.newton_equilibrium`,
+the Newton of :func:`bifilar.rig.statics.rest_pose`), checks the pose as ``rest_pose`` does (every wire
+pulls, residual at machine precision, stable) and solves the small-oscillation problem of
+:mod:`bifilar.motion.modes` (the same reduced M and K, eigen-solved as L^-1 K L^-T with M = L L^T), in
+one compiled call. It hands back a status instead of raising: a configuration it cannot settle
+cleanly -- Newton not converging from the neighbour, an unstable or neutral pose (a neutral tilt needs
+the representative that ``rest_pose`` picks), or two modes of equal frequency (``linearize``
+resolves their basis deterministically) -- is evaluated by the general path instead
+(:func:`bifilar.sweep.evaluate.evaluate`), which is also the reference the tests hold this one to.
+
+:func:`peak_tension` is the largest wire tension over the three states of each measured mode that
+:mod:`bifilar.sweep.evaluate` describes, with the tensions of the N-wire model's kernel.
+"""
+
+from __future__ import annotations
+
+import numba as nb
+import numpy as np
+
+from bifilar.motion import nwire_kernel as NK
+from bifilar.rig import pose_kernel as PK
+
+OK, NO_NEWTON, SLACK, NO_MODES, UNSTABLE, NEUTRAL, DEGENERATE = range(7)
+_NEWTON_ITERATIONS = 30  # as bifilar.rig.statics
+_RESIDUAL = 1e-12
+
+
+@nb.njit(cache=True)
+def continued_modes(arms, anchors, lengths, mass, gravity, inertia, scale, com, rot, tensions,
+                    null_rtol, neutral_rtol, degenerate_rtol, slack_rtol):
+    """(status, com, rotation, tensions, omega^2 ascending, shapes 6 x n): the rest pose found by Newton
+    from (com, rot, tensions) and its modes, each shape the pose displacement (x, theta; world) of an
+    M-normalised eigenvector. ``status`` is :data:`OK` or why the general path must take over."""
+    empty = np.zeros(0)
+    weight = mass * gravity
+    com, rot, tensions, residual, _ = PK.newton_equilibrium(com, rot, tensions, arms, anchors, lengths, weight,
+                                                            scale, _NEWTON_ITERATIONS)
+    if not residual <= _RESIDUAL:
+        return NO_NEWTON, com, rot, tensions, empty, np.zeros((6, 0))
+    if tensions.min() <= 0.0:
+        return SLACK, com, rot, tensions, empty, np.zeros((6, 0))
+    z, mr, kr, _ = PK.reduced_matrices(com, rot, tensions, arms, anchors, inertia, mass, scale, null_rtol)
+    n = z.shape[1]
+    if n == 0:
+        return NO_MODES, com, rot, tensions, empty, np.zeros((6, 0))
+    chol_inv = np.linalg.inv(np.linalg.cholesky(mr))
+    a = chol_inv @ kr @ chol_inv.T
+    w2, y = np.linalg.eigh(0.5 * (a + a.T))
+    big = max(np.abs(w2).max(), 1e-300)
+    if w2[0] < -slack_rtol * big:
+        return UNSTABLE, com, rot, tensions, w2, np.zeros((6, 0))
+    if w2[0] <= neutral_rtol * big:
+        return NEUTRAL, com, rot, tensions, w2, np.zeros((6, 0))
+    for k in range(n - 1):
+        if w2[k + 1] - w2[k] <= degenerate_rtol * big:
+            return DEGENERATE, com, rot, tensions, w2, np.zeros((6, 0))
+    return OK, com, rot, tensions, w2, z @ (chol_inv.T @ y)
+
+
+@nb.njit(cache=True)
+def peak_tension(com, rot, shapes, omegas, arms, anchors, inertia, mass, gravity, air):
+    """Largest tension (N) over the modes ``shapes[k]`` (x, theta; world) of angular frequency
+    ``omegas[k]`` (rad/s) and over their states: at rest with velocity omega * shape, and at rest
+    displaced by +-shape without velocity."""
+    y = np.zeros(NK.STATE_SIZE)
+    peak = -np.inf
+    for k in range(shapes.shape[0]):
+        y[:3] = com
+        y[3:7] = NK.matrix_quat(rot)
+        y[7:13] = omegas[k] * shapes[k]
+        peak = max(peak, NK.tensions(y, arms, anchors, inertia, mass, gravity, air).max())
+        for sign in (1.0, -1.0):
+            y[:3] = com + sign * shapes[k, :3]
+            y[3:7] = NK.matrix_quat(PK.rotation_vector_matrix(sign * shapes[k, 3:]) @ rot)
+            y[7:13] = 0.0
+            peak = max(peak, NK.tensions(y, arms, anchors, inertia, mass, gravity, air).max())
+    return peak
