@@ -310,10 +310,33 @@ def sysid_default_step(ctx: CaseContext):
 
     truth, noisy, (coarse, fine) = _sysid_fits((SYSID_STEP, CHOSEN.timestep))
     return [
-        check(f"clean record, MuJoCo step {CHOSEN.timestep:g} s: identified / true - 1", abs(fine.moment / truth - 1.0), 1e-7,
-              "(w h)^2 / 24 / 0.5 = 1.3e-9 at 4e-5 s; the Kane record's rtol 1e-10; measured 1.1e-7 at 4e-4 s"),
+        check(f"clean record, MuJoCo step {CHOSEN.timestep:g} s: identified / true - 1", abs(fine.moment / truth - 1.0), 1e-8,
+              "(w h)^2 / 24 / 0.5 = 1.3e-9 at 4e-5 s (measured 1.1e-7 at 4e-4 s: h^2); Kane's rtol 1e-10"),
         check(f"step {SYSID_STEP:g} s vs {CHOSEN.timestep:g} s: moment shift / sigma of the noisy fit",
               abs(coarse.moment - fine.moment) / noisy.std, 0.1, "the coarse step must not matter against the noise"),
+    ]
+
+
+@case("identify-sysid-coverage", source="issue 13 item 9", engines=("kane", "mujoco"), tags=("slow",))
+def sysid_coverage(ctx: CaseContext):
+    """identify-sysid-kane-record's clean record with 50 noise seeds: MuJoCo sysid's 95 % interval
+    holds the rig file's moment as often as it should, and its sigma is the spread of its estimates."""
+    from ..mujoco_sysid import fit_moment, kane_gyro_record
+
+    r = rig(SYSID_RIG)
+    truth = ident.moment(r, "z")
+    clean = kane_gyro_record(r, "z", SYSID_AMPLITUDE, SYSID_CYCLES, SYSID_HZ, SYSID_NOISE)
+    trials = 50
+    rng = np.random.default_rng(SYSID_SEED)
+    fits = [fit_moment(r, "z", clean.noisy(rng), SYSID_GUESS * truth, SYSID_STEP) for _ in range(trials)]
+    hits = np.mean([abs(f.moment - truth) <= f.interval95 for f in fits])
+    spread = np.std([f.moment for f in fits], ddof=1) / np.mean([f.std for f in fits])
+    low, _ = binom.interval(0.999, trials, LEVEL)  # its upper end is all 50: a sigma too large shows in the spread
+    return [
+        check("coverage of sysid's 95 % interval", hits, low / trials, f"binomial 99.9 % range for {trials} trials",
+              at_least=True),
+        check("spread of the estimates / sysid's sigma - 1", abs(spread - 1.0), 0.35,
+              f"sample std of {trials} normal draws: relative error 1/sqrt(2 (n - 1)) = 0.10, 3.5 of them"),
     ]
 
 
