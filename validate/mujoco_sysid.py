@@ -145,7 +145,7 @@ def fit_moment(rig: Rig, axis, record: GyroRecord, guess: float, timestep: float
     params.add(sysid.Parameter("moment", nominal=guess, min_value=low, max_value=high, modifier=write))
     first = ident.linear_period(ident.with_moment(rig, axis, guess), axis) * FIRST_WINDOW
     for end in (first, record.t[-1]):
-        keep = record.t <= end + 1e-9
+        keep = record.t <= end + 1e-9  # s: the last sample's time is a sum of steps, rounded
         t = record.t[keep]
         sequences = sysid.ModelSequences(rig.name, spec, "gyro", initial, sysid.TimeSeries(t, np.zeros((len(t), 0))),
                                          sysid.TimeSeries.from_names(t, record.rate[keep], model))
