@@ -123,8 +123,10 @@ _MIN_BOX = 0.02  # thinnest edge of the body's drawing box, per metre of its lon
 
 
 def build_spec(rig: Rig, cables: str = "tendon", numerics: Numerics = CHOSEN, scene: bool = False,
-               rest: Rest | None = None) -> mujoco.MjSpec:
-    """The rig as an :class:`mujoco.MjSpec` (not compiled); ``scene`` adds floor, light and beam."""
+               rest: Rest | None = None, *, gyro: bool = False) -> mujoco.MjSpec:
+    """The rig as an :class:`mujoco.MjSpec` (not compiled); ``scene`` adds floor, light and beam;
+    ``gyro`` adds a site ``imu`` at the COM (body axes) and a sensor ``gyro`` there: the body's angular
+    velocity in body axes (rad/s), what a rate gyro strapped to the body reads (for mujoco.sysid)."""
     if cables not in CABLES:
         raise RigError(rig.source, "cables", f"unknown cable model {cables!r} (known: {', '.join(CABLES)})")
     if numerics.integrator not in _INTEGRATORS:
@@ -149,6 +151,9 @@ def build_spec(rig: Rig, cables: str = "tendon", numerics: Numerics = CHOSEN, sc
     inertia = rig.inertia
     body.fullinertia = [inertia[0, 0], inertia[1, 1], inertia[2, 2], inertia[0, 1], inertia[0, 2], inertia[1, 2]]
     body.add_freejoint(name="free")
+    if gyro:
+        body.add_site(name="imu", pos=rig.com)
+        spec.add_sensor(name="gyro", type=mujoco.mjtSensor.mjSENS_GYRO, objtype=mujoco.mjtObj.mjOBJ_SITE, objname="imu")
     size, box_quat = _inertia_box(rig)
     body.add_geom(spec.find_default("visual"), name="body", type=mujoco.mjtGeom.mjGEOM_BOX, size=size,
                   pos=rig.com, quat=box_quat, rgba=_BODY_RGBA)
