@@ -1,4 +1,4 @@
-"""MuJoCo's own system identification (validate/mujoco_sysid.py) on Kane-simulated gyro records of
+"""MuJoCo's own system identification (validate/engines/mujoco_sysid.py) on Kane-simulated gyro records of
 models/rigs/bench_plate.toml: it recovers the rig file's I_zz within its stated sigma, it does not
 recover it from a record of another body, and the two facts the glue rests on (the rollout's one-step
 sensor lag, the physical range of the moment) hold."""
@@ -15,7 +15,7 @@ from bifilar.identification import identify as ident
 from bifilar.rig import RigError
 from validate.assets import rig
 from validate.engines import mjcf
-from validate.mujoco_sysid import fit_moment, kane_gyro_record, physical_range
+from validate.engines.mujoco_sysid import fit_moment, kane_gyro_record, physical_range
 
 PLATE = rig("bench_plate")
 TRUTH = ident.moment(PLATE, "z")

@@ -272,7 +272,7 @@ SYSID_SEED = 13
 
 def _sysid_fits(timesteps):
     """(truth, noisy fit at SYSID_STEP, clean fits at each of ``timesteps``) for the identify-sysid cases."""
-    from ..mujoco_sysid import fit_moment, kane_gyro_record
+    from ..engines.mujoco_sysid import fit_moment, kane_gyro_record
 
     r = rig(SYSID_RIG)
     truth = ident.moment(r, "z")
@@ -285,7 +285,7 @@ def _sysid_fits(timesteps):
 def sysid_kane_record(ctx: CaseContext):
     """The other direction of identify-mujoco-record: bench_plate's torsion simulated by the Kane model
     and read as a noisy body-axis gyro (100 Hz, 0.01 rad/s, 4 cycles from 0.3 rad), fitted by MuJoCo's
-    own system identification (mujoco.sysid, validate/mujoco_sysid.py) adjusting I_zz of the MuJoCo rig
+    own system identification (mujoco.sysid, validate/engines/mujoco_sysid.py) adjusting I_zz of the MuJoCo rig
     from 20 % low: it recovers the rig file's moment within the sigma it states."""
     truth, noisy, (clean,) = _sysid_fits((SYSID_STEP,))
     n = noisy.samples
@@ -321,7 +321,7 @@ def sysid_default_step(ctx: CaseContext):
 def sysid_coverage(ctx: CaseContext):
     """identify-sysid-kane-record's clean record with 50 noise seeds: MuJoCo sysid's 95 % interval
     holds the rig file's moment as often as it should, and its sigma is the spread of its estimates."""
-    from ..mujoco_sysid import fit_moment, kane_gyro_record
+    from ..engines.mujoco_sysid import fit_moment, kane_gyro_record
 
     r = rig(SYSID_RIG)
     truth = ident.moment(r, "z")

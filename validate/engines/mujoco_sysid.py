@@ -45,7 +45,7 @@ from bifilar.motion.simulate import simulate
 from bifilar.rig import Rig, RigError
 from bifilar.rig.statics import State
 
-from .engines import mjcf
+from . import mjcf
 
 FIRST_WINDOW = 1.0  # cycles of the guess's linear period (module docstring: safe below 2.5)
 # MuJoCo refuses a body whose principal moments break I1 + I2 >= I3; the bounds stay this far inside.
