@@ -31,6 +31,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from bifilar.bodies.boat import lowest_point as boat_lowest_point
 from bifilar.bodies.composite import equivalent_box
 from bifilar.identification import identify as ident
 from bifilar.identification.air import vacuum
@@ -60,6 +61,7 @@ class Row:
     tension_peak: float = math.nan  # N
     sigma: dict | None = None  # axis -> relative sigma (None: not identifiable or not measured)
     dominant: dict | None = None  # axis -> the uncertainty group with the largest share
+    budget: dict | None = None  # axis -> {uncertainty group: its share of the variance}
     separation: float = math.nan  # smallest relative gap between two mode periods
     clearance: float = math.nan  # m of the lowest point above the floor (the margin is a limit)
     air_share: dict | None = None  # axis -> 1 - (T_vacuum / T)^2 of its mode: the air's part (rigs with [air])
@@ -102,8 +104,12 @@ def measured_mode(rig: Rig, lin: Modes, about: np.ndarray) -> int:
     return max(range(len(lin.modes)), key=lambda i: share(lin.modes[i]))
 
 
-def lowest_point(rig: Rig, rest: Rest) -> float:
-    """World z (m) of the lowest corner of the body's inertia-equivalent box at rest."""
+def lowest_point(rig: Rig, rest: Rest, parts=None) -> float:
+    """World z (m) of the body's lowest point at rest: of its ``parts`` (a suspension file's,
+    :func:`bifilar.bodies.boat.lowest_point`, exact per primitive) if given, else the lowest corner of
+    its inertia-equivalent box."""
+    if parts is not None:
+        return float(boat_lowest_point(parts, rest.com - rest.rotation @ rig.com, rest.rotation)[0][0])
     half, axes = equivalent_box(rig.mass, rig.inertia)
     corners = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)]) * half
     body = rig.com + corners @ axes.T
@@ -129,7 +135,7 @@ def evaluate(space: Space, values: dict[str, float], guess: Rest | None = None) 
     row.motions = tuple(([m.motion for m in lin.modes] + [""] * 4)[:4])
     osc = sorted(p for p in row.periods if p is not None)
     row.separation = min((b - a) / b for a, b in zip(osc, osc[1:])) if len(osc) > 1 else math.nan
-    row.sigma, row.dominant = {}, {}
+    row.sigma, row.dominant, row.budget = {}, {}, {}
     peaks = [float(rest.tensions.max())]
     bases = {}
     for axis in space.measure:
@@ -143,6 +149,7 @@ def evaluate(space: Space, values: dict[str, float], guess: Rest | None = None) 
     for axis, spread in spreads.items():
         row.sigma[axis] = spread.std / spread.moment
         row.dominant[axis] = max(spread.budget, key=spread.budget.get) if spread.std > 0.0 else None
+        row.budget[axis] = spread.budget
         about = rest.rotation @ ident.axis_vector(axis)
         peaks.append(peak_tension(rig, lin, measured_mode(rig, lin, about), about, space.amplitude))
     row.tension_peak = float(np.nanmax(peaks))
@@ -155,7 +162,7 @@ def evaluate(space: Space, values: dict[str, float], guess: Rest | None = None) 
             row.air_share[axis] = 1.0 - (2.0 * np.pi / np.sqrt(w2[k]) / b.period) ** 2
     limits = space.limits
     if limits.floor is not None:
-        row.clearance = lowest_point(rig, rest) - limits.floor
+        row.clearance = lowest_point(rig, rest, space.parts) - limits.floor
     problems = []
     if any(v is None for v in row.sigma.values()):
         problems.append("an axis cannot be identified")
