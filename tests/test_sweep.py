@@ -209,3 +209,80 @@ def test_a_sweep_in_air_says_how_much_of_each_period_is_air(tmp_path):
     air = added_inertia(wing.air, wing.com, np.array([0.0, 0.0, 1.0]))
     assert row["air_share"]["z"] == pytest.approx(air / (own + air), rel=1e-3)
     assert row["air_share"]["x"] is None  # not measured
+
+
+# --- explicit points and suspension files (issue 10, item 6) ------------------------------------
+
+POINTS = 'rig = "rig.toml"\n[[point]]\nname = "a"\nwire_length = 1.0\nattach_span = 0.3\n' \
+         '[[point]]\nwire_length = 2.5\nattach_span = 0.6\n[measure]\naxes = ["z"]\n'
+
+
+def test_points_are_evaluated_in_file_order_as_given(tmp_path):
+    """Two [[point]] tables: two configurations, not their 2 x 2 grid, each configured as written."""
+    space = load_space(_write(tmp_path, POINTS))
+    assert space.size == 2 and space.names == ("a", None)
+    assert list(space.points()) == [{"wire_length": 1.0, "attach_span": 0.3}, {"wire_length": 2.5, "attach_span": 0.6}]
+    rows = sweep_run.run(str(tmp_path / "space.toml"), space, tmp_path / "o", jobs=1)
+    for values, row in zip(space.points(), rows):
+        rig = configure(space.rig, values)
+        assert rig.wires[0].length == values["wire_length"]
+        assert np.linalg.norm(rig.wires[0].attach - rig.wires[1].attach) == pytest.approx(values["attach_span"], rel=1e-15)
+        assert row["periods"] == pytest.approx([m.period for m in linearize(rig, rest_pose(rig)).modes], rel=1e-10)
+
+
+def test_attach_inset_moves_both_attachments_in_from_the_base():
+    """attach_inset d: each attachment moves d towards the other, so the span shrinks by 2 d and the
+    midpoint stays."""
+    from validate.assets import rig as shipped
+
+    rig = shipped("bench_plate")
+    moved = configure(rig, {"attach_inset": 0.05})
+    a, b = rig.wires[0].attach, rig.wires[1].attach
+    unit = (b - a) / np.linalg.norm(b - a)
+    np.testing.assert_allclose(moved.wires[0].attach, a + 0.05 * unit, atol=1e-15)
+    np.testing.assert_allclose(moved.wires[1].attach, b - 0.05 * unit, atol=1e-15)
+
+
+@pytest.mark.parametrize("space, field", [
+    (POINTS.replace("attach_span = 0.6\n", ""), "point[2]"),  # not the same axes
+    (POINTS.replace('name = "a"\n', 'name = "a"\nwire_lenght = 1.0\n'), "point[1].wire_lenght"),
+    (POINTS.replace("wire_length = 2.5", "wire_length = -2.5"), "point[2].wire_length"),
+    (POINTS.replace("wire_length = 2.5", 'wire_length = "long"'), "point[2].wire_length"),
+    (POINTS.replace("[[point]]\nwire_length = 2.5", '[[point]]\nname = "a"\nwire_length = 2.5'), "point[2].name"),
+    (POINTS.replace('[[point]]\nname = "a"\n', '[vary]\nwire_length = [1.0]\n[[point]]\nname = "a"\n'), "vary"),
+    ('rig = "rig.toml"\n[[point]]\nname = "only"\n', "point[1]"),
+    ('rig = "rig.toml"\n[[point]]\nattach_inset = 0.2\n', "point[1].attach_inset"),  # half the 0.4 m span
+    ('rig = "rig.toml"\n[vary]\nattach_inset = [0.1]\nattach_span = [0.3]\n', "attach_inset"),
+    ('rig = "rig.toml"\nsuspension = "rig.toml"\n[vary]\nwire_length = [1.0]\n', "rig"),
+])
+def test_bad_points_are_one_line_exit_2(tmp_path, capsys, space, field):
+    path = _write(tmp_path, space)
+    code, out, err = _cli(capsys, "sweep", path, "--out", tmp_path / "out")
+    assert code == 2 and out == "" and err.count("\n") == 1 and field in err, err
+
+
+def test_boat_sweep_files_load_as_the_suspension_hangs_the_boat():
+    """models/solar_boat/configurations.toml: the thesis's three configurations, whose rigs are
+    suspension.toml's; hall.toml: a grid on the same base, the hall's floor, the parts' clearance."""
+    from bifilar.bodies.boat import load_suspension
+    from bifilar.bodies.boat import lowest_point as parts_lowest
+    from validate.assets import MODELS
+
+    boat = MODELS / "solar_boat"
+    s = load_suspension(boat / "suspension.toml")
+    configurations = load_space(boat / "configurations.toml")
+    assert configurations.names == tuple(c.name for c in s.configurations)
+    for values, c in zip(configurations.points(), s.configurations):
+        for mine, theirs in zip(configure(configurations.rig, values).wires, s.rig(c).wires):
+            np.testing.assert_allclose(mine.attach, theirs.attach, atol=1e-15)
+            np.testing.assert_array_equal(mine.anchor, theirs.anchor)
+            assert mine.length == theirs.length
+    hall = load_space(boat / "hall.toml")
+    assert hall.limits.floor == -6.5 and len(hall.parts) == len(s.parts) and 1000 < hall.size < 3000  # < 2 min, 2 cores
+    assert set(hall.axes) == {"attach_inset", "wire_length"}
+    rig = configure(hall.rig, {"attach_inset": 1.0, "wire_length": 4.0})
+    rest = rest_pose(rig)
+    row = evaluate(hall, {"attach_inset": 1.0, "wire_length": 4.0})
+    low, _ = parts_lowest(s.parts, rest.com - rest.rotation @ rig.com, rest.rotation)
+    assert row.clearance == pytest.approx(low[0] + 6.5, abs=1e-9)  # the foils, not the inertia box
+    assert row.clearance < lowest_point(rig, rest) + 6.5 - 0.3  # the box ends ~0.55 m higher

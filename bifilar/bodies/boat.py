@@ -77,6 +77,16 @@ class Suspension:
         ends = np.array([[s * (0.5 * d["length"] - config.inset), 0.0, 0.5 * d["height"]] for s in (1.0, -1.0)])
         return self.deck.position + ends @ self.deck.rotation.T
 
+    @property
+    def floor(self) -> float:
+        """World z (m) of the hall's floor: ``hook_height`` under the highest hook."""
+        return float(self.hooks[:, 2].max()) - self.hook_height
+
+    def base_rig(self) -> Rig:
+        """The boat with its attachments at the deck's ends (inset 0): the base rig of a boat sweep, from
+        which the sweep's ``attach_inset`` counts the thesis's insets (bifilar/sweep/space.py)."""
+        return self.rig(Configuration("ends", 0.0))
+
     def rig(self, config: Configuration) -> Rig:
         """The checked rig of one configuration, with the file's measurement errors."""
         attach = self.attachments(config)

@@ -10,6 +10,10 @@ midpoint and the direction are the base rig's; "height" axes move along world z 
 - ``wire_length_2``: wire 2's length alone (m), for unequal wires; applied after ``wire_length``.
 - ``anchor_span``: the distance between the two ceiling anchors (m).
 - ``attach_span``: the distance between the two attachments (m), in the body frame.
+- ``attach_inset``: both attachments moved this far (m) towards each other along the line that joins
+  them, from the base rig's positions: the span becomes the base's minus twice the inset. With a
+  suspension file's base (the boat's attachments at the deck's ends) it is the thesis's distance from
+  the deck's ends (Table 8.2.1). A file gives ``attach_span`` or ``attach_inset``, not both.
 - ``attach_height``: both attachments' body-frame z (m).
 - ``anchor_height_difference``: anchor 2's world z minus anchor 1's (m), about their mean height.
 - ``platform_radius``: every attachment at this horizontal distance (m) from the body-frame vertical
@@ -59,6 +63,15 @@ def attach_span(rig: Rig, value: float) -> Rig:
     return _wires(rig, w0={"attach": a}, w1={"attach": b})
 
 
+def attach_inset(rig: Rig, value: float) -> Rig:
+    return attach_span(rig, attach_span_of(rig) - 2.0 * value)
+
+
+def attach_span_of(rig: Rig) -> float:
+    """Distance (m) between the attachments of wires 1 and 2, in the body frame."""
+    return float(np.linalg.norm(rig.wires[1].attach - rig.wires[0].attach))
+
+
 def attach_height(rig: Rig, value: float) -> Rig:
     a, b = rig.wires[0].attach.copy(), rig.wires[1].attach.copy()
     a[2] = b[2] = value
@@ -94,6 +107,7 @@ AXES = {
     "wire_length_2": wire_length_2,
     "anchor_span": anchor_span,
     "attach_span": attach_span,
+    "attach_inset": attach_inset,
     "attach_height": attach_height,
     "anchor_height_difference": anchor_height_difference,
     "platform_radius": platform_radius,

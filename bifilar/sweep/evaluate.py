@@ -32,6 +32,7 @@ from functools import lru_cache
 
 import numpy as np
 
+from bifilar.bodies.boat import lowest_point as boat_lowest_point
 from bifilar.bodies.composite import equivalent_box
 from bifilar.identification import identify as ident
 from bifilar.identification.air import vacuum
@@ -61,6 +62,7 @@ class Row:
     tension_peak: float = math.nan  # N
     sigma: dict | None = None  # axis -> relative sigma (None: not identifiable or not measured)
     dominant: dict | None = None  # axis -> the uncertainty group with the largest share
+    budget: dict | None = None  # axis -> {uncertainty group: its share of the variance}
     separation: float = math.nan  # smallest relative gap between two mode periods
     clearance: float = math.nan  # m of the lowest point above the floor (the margin is a limit)
     air_share: dict | None = None  # axis -> 1 - (T_vacuum / T)^2 of its mode: the air's part (rigs with [air])
@@ -106,8 +108,12 @@ def measured_mode(rig: Rig, lin: Modes, about: np.ndarray) -> int:
     return max(range(len(lin.modes)), key=lambda i: share(lin.modes[i]))
 
 
-def lowest_point(rig: Rig, rest: Rest) -> float:
-    """World z (m) of the lowest corner of the body's inertia-equivalent box at rest."""
+def lowest_point(rig: Rig, rest: Rest, parts=None) -> float:
+    """World z (m) of the body's lowest point at rest: of its ``parts`` (a suspension file's,
+    :func:`bifilar.bodies.boat.lowest_point`, exact per primitive) if given, else the lowest corner of
+    its inertia-equivalent box."""
+    if parts is not None:
+        return float(boat_lowest_point(parts, rest.com - rest.rotation @ rig.com, rest.rotation)[0][0])
     body = rig.com + _box_corners(float(rig.mass), *np.asarray(rig.inertia, dtype=float).ravel())
     world = rest.com + (body - rig.com) @ rest.rotation.T
     return float(world[:, 2].min())
@@ -155,7 +161,7 @@ def _continued(space: Space, rig: Rig, row: Row, guess: Rest) -> bool:
     row.periods = tuple(([float(p) for p in periods] + [None] * 4)[:4])
     row.motions = tuple(([motion_of(rig, rest, shapes[:3, k], shapes[3:, k]) for k in range(len(w2))] + [""] * 4)[:4])
     row.separation = float(np.min((periods[:-1] - periods[1:]) / periods[:-1])) if len(w2) > 1 else math.nan
-    row.sigma, row.dominant = {}, {}
+    row.sigma, row.dominant, row.budget = {}, {}, {}
     bases, chosen = {}, {}
     for axis in space.measure:
         about = rot @ ident.axis_vector(axis)
@@ -183,6 +189,7 @@ def _continued(space: Space, rig: Rig, row: Row, guess: Rest) -> bool:
 def _record(row: Row, axis: str, spread) -> None:
     row.sigma[axis] = spread.std / spread.moment
     row.dominant[axis] = max(spread.budget, key=spread.budget.get) if spread.std > 0.0 else None
+    row.budget[axis] = spread.budget
 
 
 def _general(space: Space, rig: Rig, row: Row, guess: Rest | None) -> None:
@@ -197,7 +204,7 @@ def _general(space: Space, rig: Rig, row: Row, guess: Rest | None) -> None:
     row.motions = tuple(([m.motion for m in lin.modes] + [""] * 4)[:4])
     osc = sorted(p for p in row.periods if p is not None)
     row.separation = min((b - a) / b for a, b in zip(osc, osc[1:])) if len(osc) > 1 else math.nan
-    row.sigma, row.dominant = {}, {}
+    row.sigma, row.dominant, row.budget = {}, {}, {}
     peaks = [float(rest.tensions.max())]
     bases = {}
     for axis in space.measure:
@@ -226,7 +233,7 @@ def _limits(space: Space, rig: Rig, row: Row) -> None:
     """Clearance and the limits: ``row.feasible`` and the reasons it is not."""
     limits = space.limits
     if limits.floor is not None:
-        row.clearance = lowest_point(rig, row.rest) - limits.floor
+        row.clearance = lowest_point(rig, row.rest, space.parts) - limits.floor
     problems = []
     if any(v is None for v in row.sigma.values()):
         problems.append("an axis cannot be identified")

@@ -1,4 +1,4 @@
-"""The sweep file: a base rig and the axes to vary over, the limits and what is to be measured.
+"""The sweep file: a base rig and the configurations to evaluate, the limits and what is to be measured.
 
 TOML, SI units and radians, the rig file's conventions::
 
@@ -16,6 +16,18 @@ TOML, SI units and radians, the rig file's conventions::
     objective = "worst"            # "worst" (max relative sigma over axes, default) or "mean"
 
 The grid is the Cartesian product of the axes, in file order, the last axis fastest.
+
+Instead of ``[vary]``, a file may list explicit configurations, each a ``[[point]]`` table of axis
+values (every point the same axes; an optional unique ``name``), evaluated in file order::
+
+    [[point]]
+    name = "3"                     # optional
+    attach_inset = 1.0             # m, any axis of bifilar.sweep.axes
+
+Instead of ``rig``, ``suspension = "suspension.toml"`` names a suspension file
+(:mod:`bifilar.bodies.boat`): the base rig is its body hung from the hall's hooks with the attachments
+at the deck's ends (so ``attach_inset`` is the thesis's inset), ``limits.floor`` defaults to the hall's
+floor, and the clearance is that of the lowest point of the body's parts, not of its inertia box.
 """
 
 from __future__ import annotations
@@ -27,14 +39,16 @@ from pathlib import Path
 
 import numpy as np
 
+from bifilar.bodies.boat import load_suspension
+from bifilar.bodies.composite import Part
 from bifilar.rig import Rig, RigError, load_rig
 from bifilar.rig.checks import no_unknown, number, positive, read_toml, required, table
-from bifilar.sweep.axes import AXES, POSITIVE
+from bifilar.sweep.axes import AXES, POSITIVE, attach_span_of
 
 MAX_POINTS = 10**7  # a larger grid is a mistake: 10^7 configurations take hours even at 1000/s
 MAX_STEPS = 10**6  # per axis
 OBJECTIVES = ("worst", "mean")
-_TOP = {"rig", "vary", "limits", "measure"}
+_TOP = {"rig", "suspension", "vary", "point", "limits", "measure"}
 _LIMITS = {"tension", "floor", "clearance"}
 _MEASURE = {"axes", "amplitude", "objective"}
 _RANGE = {"from", "to", "steps", "log"}
@@ -56,15 +70,21 @@ class Space:
     measure: tuple[str, ...]  # body axes "x", "y", "z"
     amplitude: float  # rad
     objective: str
+    explicit: bool = False  # the configurations are the [[point]] tables: axes[name][k] is point k's
+    names: tuple[str | None, ...] = ()  # the points' names (explicit files)
+    parts: tuple[Part, ...] | None = None  # the body's parts (suspension files): its clearance
 
     @property
     def size(self) -> int:
+        if self.explicit:
+            return len(next(iter(self.axes.values())))
         return int(np.prod([len(v) for v in self.axes.values()]))
 
     def points(self):
-        """Every configuration as a dict axis -> value, in grid order."""
+        """Every configuration as a dict axis -> value, in grid (or file) order."""
         names = list(self.axes)
-        for combo in itertools.product(*self.axes.values()):
+        combos = zip(*self.axes.values()) if self.explicit else itertools.product(*self.axes.values())
+        for combo in combos:
             yield dict(zip(names, (float(v) for v in combo)))
 
 
@@ -96,9 +116,58 @@ def _values(raw, src: str, name: str) -> np.ndarray:
             values = np.linspace(low, high, steps)
     else:
         raise RigError(src, field, "must be a list of values or a table {from, to, steps}")
+    return values
+
+
+def _check_axis(rig: Rig, name: str, values: np.ndarray, src: str, field: str) -> None:
+    """The values' physical range: distances above zero, an inset short of the attachments' midpoint."""
     if name in POSITIVE and values.min() <= 0.0:
         raise RigError(src, field, f"must be above zero (a distance, m); found {values.min():g}")
-    return values
+    if name == "attach_inset":
+        half = 0.5 * attach_span_of(rig)
+        if values.min() < 0.0 or values.max() >= half:
+            raise RigError(src, field, f"must be from 0 to under half the base rig's attachment span ({half:g} m); "
+                                       f"found {values.min():g} to {values.max():g}")
+
+
+def _points(raw, src: str) -> tuple[dict[str, np.ndarray], tuple]:
+    """The [[point]] tables as axis -> values (point order) and their names."""
+    if not isinstance(raw, list) or not raw or not all(isinstance(p, dict) for p in raw):
+        raise RigError(src, "point", "must be [[point]] tables of axis values")
+    if len(raw) > MAX_POINTS:
+        raise RigError(src, "point", f"{len(raw)} points: at most {MAX_POINTS}")
+    first = [k for k in raw[0] if k != "name"]
+    columns, names = {k: [] for k in first}, []
+    for i, point in enumerate(raw, start=1):
+        prefix = f"point[{i}]."
+        no_unknown(point, set(AXES) | {"name"}, src, prefix)
+        keys = [k for k in point if k != "name"]
+        if not keys:
+            raise RigError(src, f"point[{i}]", "no axis value: give at least one of " + ", ".join(AXES))
+        if set(keys) != set(first):
+            raise RigError(src, f"point[{i}]", f"gives {', '.join(sorted(keys))}; every point must give the same "
+                                               f"axes as point[1] ({', '.join(sorted(first))})")
+        name = point.get("name")
+        if name is not None and (not isinstance(name, str) or not name or name in names):
+            raise RigError(src, prefix + "name", f"must be a non-empty, unique string, got {name!r}")
+        names.append(name)
+        for k in first:
+            columns[k].append(number(point[k], src, prefix + k))
+    return {k: np.array(v) for k, v in columns.items()}, tuple(names)
+
+
+def _base(data: dict, src: str, path: Path):
+    """The base rig and, for a suspension file, its parts and the hall's floor."""
+    given = [k for k in ("rig", "suspension") if k in data]
+    if len(given) != 1:
+        raise RigError(src, "rig", "give the base as rig = RIG.toml or suspension = SUSPENSION.toml (one of them)")
+    key = given[0]
+    if not isinstance(data[key], str):
+        raise RigError(src, key, f"must be the path of a {key} file (relative to this file)")
+    if key == "rig":
+        return load_rig(path.parent / data[key]), None, None
+    s = load_suspension(path.parent / data[key])
+    return s.base_rig(), s.parts, s.floor
 
 
 def load_space(path: str | Path) -> Space:
@@ -106,26 +175,35 @@ def load_space(path: str | Path) -> Space:
     src = str(path)
     data = read_toml(path)
     no_unknown(data, _TOP, src, "")
-    rig_name = required(data, "rig", src, "")
-    if not isinstance(rig_name, str):
-        raise RigError(src, "rig", "must be the path of a rig file (relative to this file)")
-    rig = load_rig(Path(path).parent / rig_name)
-    vary = table(data, "vary", src, mandatory=True)
-    if not vary:
-        raise RigError(src, "vary", "no axis to vary: name at least one of " + ", ".join(AXES))
-    axes = {}
-    for name, raw in vary.items():
-        if name not in AXES:
-            raise RigError(src, f"vary.{name}", "unknown axis; the axes are " + ", ".join(AXES))
-        axes[name] = _values(raw, src, name)
-    total = math.prod(len(v) for v in axes.values())
-    if total > MAX_POINTS:
-        raise RigError(src, "vary", f"{total} configurations: at most {MAX_POINTS}")
+    rig, parts, hall_floor = _base(data, src, Path(path))
+    if ("vary" in data) == ("point" in data):
+        raise RigError(src, "vary", "give the configurations as a [vary] grid or as [[point]] tables (one of them)")
+    if "point" in data:
+        axes, names = _points(data["point"], src)
+        for name, values in axes.items():
+            for i in range(len(values)):
+                _check_axis(rig, name, values[i:i + 1], src, f"point[{i + 1}].{name}")
+    else:
+        vary, names = table(data, "vary", src, mandatory=True), ()
+        if not vary:
+            raise RigError(src, "vary", "no axis to vary: name at least one of " + ", ".join(AXES))
+        axes = {}
+        for name, raw in vary.items():
+            if name not in AXES:
+                raise RigError(src, f"vary.{name}", "unknown axis; the axes are " + ", ".join(AXES))
+            axes[name] = _values(raw, src, name)
+        total = math.prod(len(v) for v in axes.values())
+        if total > MAX_POINTS:
+            raise RigError(src, "vary", f"{total} configurations: at most {MAX_POINTS}")
+        for name, values in axes.items():
+            _check_axis(rig, name, values, src, f"vary.{name}")
+    if "attach_span" in axes and "attach_inset" in axes:
+        raise RigError(src, "attach_inset", "give attach_span or attach_inset, not both")
     lim = table(data, "limits", src, mandatory=False)
     no_unknown(lim, _LIMITS, src, "limits.")
     limits = Limits(
         tension=positive(lim["tension"], src, "limits.tension") if "tension" in lim else None,
-        floor=number(lim["floor"], src, "limits.floor") if "floor" in lim else None,
+        floor=number(lim["floor"], src, "limits.floor") if "floor" in lim else hall_floor,
         clearance=number(lim.get("clearance", 0.0), src, "limits.clearance"),
     )
     if limits.clearance < 0.0:
@@ -141,4 +219,5 @@ def load_space(path: str | Path) -> Space:
     objective = meas.get("objective", "worst")
     if objective not in OBJECTIVES:
         raise RigError(src, "measure.objective", "must be one of " + ", ".join(OBJECTIVES))
-    return Space(src, rig, axes, limits, tuple(dict.fromkeys(measured)), amplitude, objective)
+    return Space(src, rig, axes, limits, tuple(dict.fromkeys(measured)), amplitude, objective,
+                 explicit="point" in data, names=names, parts=parts)

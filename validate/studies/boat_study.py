@@ -9,8 +9,10 @@ For every configuration:
   roll I3. The Kane model's period of that release is the "measured" period; the exact inversion
   (:func:`bifilar.identify.identify`, with the amplitude correction) turns it into the moment,
   starting from the thesis's own estimate (Table 8.3.4). The truth is the parts' moment about the
-  body axis; the predicted standard deviation of each moment comes from the suspension file's
-  ``[uncertainty]`` (:func:`bifilar.propagation.linear`).
+  body axis. The rest pose, the modes and the predicted standard deviation of each moment (the
+  suspension file's ``[uncertainty]`` propagated through the exact inversion) are the sweep's: each
+  configuration is a point of :func:`sweep_space` evaluated by :func:`bifilar.sweep.evaluate.evaluate`,
+  as ``python -m validate sweep models/solar_boat/configurations.toml`` does.
 * Loads and clearance (ch. 8.3-8.4). The torsion at pi/12 (Fig. 8.4.1) and the other two motions at
   pi/80, each simulated for five periods of the rig's slowest mode and sampled every 0.01 s (an
   extreme between samples is missed by at most (omega dt)^2 / 8 of the oscillating part; the
@@ -29,11 +31,12 @@ import numpy as np
 from bifilar.identification import identify as ident
 from bifilar.bodies.boat import Configuration, Suspension, attachment_forces, lowest_point
 from bifilar.identification.identify import Identified
-from bifilar.motion.modes import linearize
-from bifilar.identification.propagation import Propagation, linear
 from bifilar.rig import Rig, RigError
 from bifilar.motion.simulate import KaneRun, simulate
-from bifilar.rig.statics import Rest, rest_pose
+from bifilar.rig.statics import Rest
+from bifilar.sweep.axes import configure
+from bifilar.sweep.evaluate import Row, evaluate
+from bifilar.sweep.space import Limits, Space
 
 from ..assets import MODELS
 
@@ -96,7 +99,8 @@ def axis_amplitude(rig: Rig, motion: Motion, rest: Rest) -> float:
 @dataclass(frozen=True)
 class Moment:
     """One moment identified from a timed motion: the truth, the thesis's estimate (None for a
-    configuration the thesis did not study), the period timed at ``amplitude`` and what it gives."""
+    configuration the thesis did not study), the period timed at ``amplitude`` and what it gives;
+    the predicted relative standard deviation and its budget are the sweep's (module docstring)."""
 
     name: str
     axis: str
@@ -105,12 +109,18 @@ class Moment:
     amplitude: float  # rad about the axis
     period: float  # s, at that amplitude
     found: Identified
-    spread: Propagation
+    sigma: float  # relative standard deviation of the moment
+    budget: dict  # uncertainty group -> its share of the variance
+
+    @property
+    def std(self) -> float:
+        """Predicted standard deviation (kg m^2)."""
+        return self.sigma * self.truth
 
 
-def time_moment(rig: Rig, config: Configuration, motion: Motion, rest: Rest) -> Moment:
-    """Time the motion on the rig (the Kane model), identify the moment from that period starting
-    from the thesis's estimate (or its geometric value), and propagate the measurement errors."""
+def time_moment(rig: Rig, config: Configuration, motion: Motion, rest: Rest, row: Row) -> Moment:
+    """Time the motion on the rig (the Kane model) and identify the moment from that period starting
+    from the thesis's estimate (or its geometric value); its uncertainty is the sweep's ``row``'s."""
     axis = motion.axis
     delta = TABLE_8_3_4.get(config.name, {}).get(axis)
     thesis = None if delta is None else THESIS_GEOMETRIC[axis] + delta
@@ -118,8 +128,8 @@ def time_moment(rig: Rig, config: Configuration, motion: Motion, rest: Rest) -> 
     period = ident.simulated_period(rig, axis, amplitude, rest)
     start = ident.with_moment(rig, axis, THESIS_GEOMETRIC[axis] if thesis is None else thesis)
     found = ident.identify(start, axis, period, amplitude, rest)
-    spread = linear(found.rig, axis, found.period, rig.uncertainty.period)
-    return Moment(AXIS_NAME[axis], axis, ident.moment(rig, axis), thesis, amplitude, period, found, spread)
+    return Moment(AXIS_NAME[axis], axis, ident.moment(rig, axis), thesis, amplitude, period, found,
+                  row.sigma[axis], row.budget[axis])
 
 
 @dataclass(frozen=True)
@@ -167,6 +177,7 @@ class ConfigurationStudy:
     """Everything the study finds for one configuration."""
 
     config: Configuration
+    row: Row  # the sweep's evaluation of the configuration
     rig: Rig
     rest: Rest
     rest_forces: np.ndarray  # (2, 3), body frame, N
@@ -188,15 +199,27 @@ class ConfigurationStudy:
         return float(max(run.depth.max() for run in self.loads))
 
 
-def study_configuration(s: Suspension, config: Configuration) -> ConfigurationStudy:
-    rig = s.rig(config)
-    rest = rest_pose(rig)
-    slowest = max(m.period for m in linearize(rig, rest).modes if m.period is not None)
-    moments = tuple(time_moment(rig, config, m, rest) for m in TIMED)
+def sweep_space(s: Suspension) -> Space:
+    """The suspension's configurations as the points of a sweep, as models/solar_boat/configurations.toml
+    writes them (bifilar/sweep/space.py): the boat at the deck's ends, each inset an ``attach_inset``,
+    the hall's floor, the three moments, the timed amplitude pi/80."""
+    insets = np.array([c.inset for c in s.configurations])
+    return Space(s.source, s.base_rig(), {"attach_inset": insets}, Limits(floor=s.floor), tuple(a for _, a in AXES),
+                 np.pi / 80, "worst", explicit=True, names=tuple(c.name for c in s.configurations), parts=s.parts)
+
+
+def study_configuration(s: Suspension, config: Configuration, space: Space) -> ConfigurationStudy:
+    values = {"attach_inset": config.inset}
+    row = evaluate(space, values)
+    if row.rest is None:
+        raise RigError(s.source, "configuration", f"configuration {config.name}: {row.reason}")
+    rig, rest = configure(space.rig, values), row.rest
+    slowest = max(p for p in row.periods if p is not None)
+    moments = tuple(time_moment(rig, config, m, rest, row) for m in TIMED)
     loads = tuple(load_run(s, rig, m, rest, PERIODS * slowest) for m in LOADED)
     depth, _ = depth_under_hooks(s, rig, rest.com, rest.rotation)
     forces = attachment_forces(rig, rest.com, rest.rotation, rest.tensions)[0]
-    return ConfigurationStudy(config, rig, rest, forces, float(depth[0]), moments, loads)
+    return ConfigurationStudy(config, row, rig, rest, forces, float(depth[0]), moments, loads)
 
 
 @dataclass(frozen=True)
@@ -208,7 +231,8 @@ class Study:
 
 
 def run_study(s: Suspension) -> Study:
-    return Study(s, tuple(study_configuration(s, c) for c in s.configurations))
+    space = sweep_space(s)
+    return Study(s, tuple(study_configuration(s, c, space) for c in s.configurations))
 
 
 def recommend(study: Study) -> dict:
@@ -217,17 +241,17 @@ def recommend(study: Study) -> dict:
     one whose largest relative standard deviation of the three moments is smallest; and the loads."""
     confs = study.configurations
     names = [c.config.name for c in confs]
-    rel = np.array([[m.spread.std / m.found.moment for m in c.moments] for c in confs])  # (configuration, axis)
+    rel = np.array([[m.sigma for m in c.moments] for c in confs])  # (configuration, axis)
     choice, reasons = {}, []
     for k, (axis, _) in enumerate(AXES):
         best = int(np.argmin(rel[:, k]))
         choice[axis] = "any" if rel[:, k].max() <= 1.05 * rel[best, k] else names[best]
         m = confs[best].moments[k]
-        top = max(m.spread.budget, key=m.spread.budget.get)
+        top = max(m.budget, key=m.budget.get)
         reasons.append(f"{axis}: sigma {100 * rel[best, k]:.2g} % in configuration {names[best]}, "
                        f"{100 * rel[:, k].max():.2g} % in configuration {names[int(np.argmax(rel[:, k]))]} "
                        f"(d ln T / d ln I = {m.found.sensitivity:.2g}, largest error source: {top}, "
-                       f"{100 * m.spread.budget[top]:.0f} % of the variance)")
+                       f"{100 * m.budget[top]:.0f} % of the variance)")
     # A configuration whose swinging boat reaches the floor is out, whatever its accuracy.
     margin = np.array([study.suspension.hook_height - c.depth for c in confs])
     if np.all(margin < 0.0):
@@ -284,8 +308,8 @@ def _configuration(c: ConfigurationStudy, hook_height: float) -> dict:
         "periods": [m.period for m in c.moments],
         "amplitudes": [m.amplitude for m in c.moments],
         "sensitivity": [m.found.sensitivity for m in c.moments],
-        "std": [m.spread.std for m in c.moments],
-        "budget": [m.spread.budget for m in c.moments],
+        "std": [m.std for m in c.moments],
+        "budget": [m.budget for m in c.moments],
         "tension_rest": c.rest.tensions.tolist(),
         "tension_max": c.tension_max.tolist(),
         "attachment_rest": c.rest_forces.tolist(),
