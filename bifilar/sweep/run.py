@@ -23,7 +23,15 @@ from bifilar.rig.statics import Rest
 from bifilar.sweep.evaluate import AXES, Row, evaluate
 from bifilar.sweep.space import Space, load_space
 
-CHUNK = 64  # configurations per chunk: long enough for continuation, short enough to balance cores
+# Configurations per chunk: each chunk's first rest pose is a global search (~0.1 s), the rest are
+# continued (~1 ms each), so chunks are long; but at least ~32 of them, to balance the workers. A pure
+# function of the grid's size, never of the executor: the rows are the same on any of them.
+MIN_CHUNK, MAX_CHUNK, CHUNKS = 64, 512, 32
+
+
+def chunk_size(size: int) -> int:
+    """Configurations per chunk for a grid of ``size`` (see above)."""
+    return int(min(MAX_CHUNK, max(MIN_CHUNK, math.ceil(size / CHUNKS))))
 
 
 def _plain(row: Row) -> dict:
@@ -83,8 +91,10 @@ def _save(folder: Path, name: str, rows: list[dict]) -> None:
 
 
 def run(path: str, space: Space, out: Path, jobs: int = 1, scheduler: str | None = None, progress=None,
-        chunk: int = CHUNK) -> list[dict]:
-    """Every row of the sweep, in grid order. ``progress(n_done)`` is called as chunks finish."""
+        chunk: int | None = None) -> list[dict]:
+    """Every row of the sweep, in grid order, in chunks of ``chunk`` (default :func:`chunk_size`).
+    ``progress(n_done)`` is called as chunks finish."""
+    chunk = chunk_size(space.size) if chunk is None else chunk
     chunks = [(s, min(s + chunk, space.size)) for s in range(0, space.size, chunk)]
     folder = out / ".chunks" / digest(path, chunk)
     folder.mkdir(parents=True, exist_ok=True)
