@@ -179,7 +179,8 @@ def run(args) -> int:
 
         ranked = sorted((r for r in rows if math.isfinite(objective(r, space.measure, space.objective))),
                         key=lambda r: objective(r, space.measure, space.objective))
-        data["mujoco_check"] = [check(space, r["values"]) for r in ranked[: args.check_mujoco]]
+        checked = check(space, [r["values"] for r in ranked[: args.check_mujoco]])
+        data["mujoco_check"] = [c.entry for c in checked]
     atomic_write_text(out / "sweep.csv", csv_text(list(space.axes), rows))
     atomic_write_text(out / "summary.json", json.dumps(data, indent=1, allow_nan=False) + "\n")
     if args.png:
