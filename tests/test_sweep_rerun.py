@@ -65,7 +65,8 @@ def test_rerun_holds_the_table_and_the_mujoco_motion(tmp_path, capsys):
     # the objective (worst sigma over ["z"]: sigma_z) of the feasible rows, bit for bit, at their row index
     objective = rec["sweep/series/objective"]
     assert objective["configuration"] == [i for i, ok in enumerate(feasible) if ok]
-    assert [v[0] for v in objective["Scalars:scalars"]] == [float(rows[i]["sigma_z"]) for i in objective["configuration"]]
+    sigma_z = [float(rows[i]["sigma_z"]) for i in objective["configuration"]]
+    assert [v[0] for v in objective["Scalars:scalars"]] == sigma_z
     assert [v[0] for v in rec["sweep/series/feasible"]["Scalars:scalars"]] == [float(ok) for ok in feasible]
     for axis in ("anchor_span", "wire_length"):
         assert [v[0] for v in rec[f"sweep/series/axes/{axis}"]["Scalars:scalars"]] == [float(r[axis]) for r in rows]

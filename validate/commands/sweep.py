@@ -48,7 +48,8 @@ def add_parser(subparsers):
                    help="run the K best configurations in MuJoCo and compare periods and tensions "
                         "(exit 1 if any differs by more than 1e-6; default 0: no check)")
     p.add_argument("--rerun", action="store_true",
-                   help="also write DIR/sweep.rrd: the table and the MuJoCo check's motions (open: rerun DIR/sweep.rrd)")
+                   help="also write DIR/sweep.rrd: the table and the MuJoCo check's motions "
+                        "(open: rerun DIR/sweep.rrd)")
     return p
 
 
