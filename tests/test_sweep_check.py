@@ -89,3 +89,10 @@ def test_the_batched_check_is_the_sequential_check():
             assert mb["period_rel_error"] == pytest.approx(ms["period_rel_error"], rel=0, abs=1e-12)
             assert mb["tension_rel_error"] == pytest.approx(ms["tension_rel_error"], rel=0, abs=1e-12)
         assert b.runs.keys() == s.runs.keys() == set(space.measure)
+
+
+def test_rigs_of_different_shapes_are_not_batched():
+    """One MjData per thread serves every model of a batch: two wires and three cannot share it."""
+    with pytest.raises(ValueError, match="differ in size"):
+        mujoco_rig.run_batch([mujoco_rig.BatchRun(rig("bench_plate"), 0.02, 0.01),
+                              mujoco_rig.BatchRun(rig("trifilar"), 0.02, 0.01)])

@@ -9,7 +9,8 @@ derived quantities in ``mjData`` (``efc_force``, ``ten_length``, ``qacc``) are t
 start of the last step, one step before the sampled ``qpos``; so each sample calls ``mj_forward`` to
 recompute them at the sampled state. That costs one forward pass per sample (1/250 of the work at the
 chosen step) and changes nothing in the trajectory: the next ``mj_step`` repeats that same forward
-pass. How velocities are started and read is explained in :func:`simulate`.
+pass. How velocities are started and read is explained in :func:`simulate`. :func:`run_batch` steps
+many runs at once through ``mujoco.rollout`` on every core, sampled by the same code.
 
 Refused before a step is taken: a rig whose two cable rows are so unequally loaded that MuJoCo's soft
 constraint is ill-conditioned there (:func:`row_coupling`; a slender body), and a run of more than
@@ -93,6 +94,9 @@ def run_batch(runs: Sequence[BatchRun], *, cables: str = "tendon", numerics: Num
                 for (model, start), r in zip(prepared, runs)]
     if not samplers:
         return []
+    sizes = {(s.model.nq, s.model.nv, s.model.nbody, s.model.ntendon, s.model.neq) for s in samplers}
+    if len(sizes) > 1:  # one MjData per thread serves every model: their sizes must agree
+        raise ValueError(f"run_batch: the runs' models differ in size {sorted(sizes)}; batch rigs of one shape")
     nstate = mujoco.mj_stateSize(samplers[0].model, _STATE)
     nthread = (os.cpu_count() or 1) if nthread is None else nthread
     threads = [mujoco.MjData(samplers[0].model) for _ in range(nthread)]
