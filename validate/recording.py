@@ -20,7 +20,7 @@ import os
 import re
 import uuid
 from collections import Counter
-from collections.abc import Iterable, Sequence
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -68,10 +68,20 @@ class _Run:
         return "rig_spec" in self.traj.meta and all(c in self.traj for c in RIG_CHANNELS)
 
 
+@dataclass(frozen=True)
+class Extra:
+    """More than runs in a recording (a sweep's table): ``log`` logs it into the open recording,
+    ``views`` show it, in tabs before the runs' layout."""
+
+    log: Callable[[rr.RecordingStream], None]
+    views: tuple
+
+
 def record(path: str | Path, title: str, trajectories: Sequence[Trajectory], metrics: Iterable[Metric] = (),
-           passed: bool | None = None, note: str = "") -> Path:
+           passed: bool | None = None, note: str = "", extra: Extra | None = None) -> Path:
     """Write one .rrd of ``trajectories`` (see the module docstring) with ``metrics``, the verdict
-    ``passed`` (None: no verdict) and a free ``note`` (e.g. the error a case raised). Returns the path."""
+    ``passed`` (None: no verdict), a free ``note`` (e.g. the error a case raised) and ``extra``.
+    Returns the path."""
     runs = _runs(trajectories)
     diffs = [(ref, run, differences(ref.traj, run.traj)) for ref, run in _compared(runs)]
     path = Path(path)
@@ -81,8 +91,10 @@ def record(path: str | Path, title: str, trajectories: Sequence[Trajectory], met
     tmp = path.with_name(f".{path.name[:48]}.{uuid.uuid4().hex}.rrd")
     try:
         rec = rr.RecordingStream(APP_ID)
-        rec.save(tmp, default_blueprint=_blueprint(runs, diffs))
+        rec.save(tmp, default_blueprint=_blueprint(runs, diffs, extra.views if extra else ()))
         rec.send_recording_name(title)
+        if extra:
+            extra.log(rec)
         _log_scene(rec, [r for r in runs if r.drawn])
         _log_series(rec, runs, diffs)
         rec.log("summary", rr.TextDocument(_summary(title, runs, list(metrics), passed, note),
@@ -309,9 +321,9 @@ def _plot(origin: str, channel: str, what: str) -> rrb.TimeSeriesView:
     return rrb.TimeSeriesView(origin=origin, name=f"{what} ({unit})" if unit else what)
 
 
-def _blueprint(runs: list[_Run], diffs: list) -> rrb.Blueprint:
+def _blueprint(runs: list[_Run], diffs: list, extra_views: tuple = ()) -> rrb.Blueprint:
     """3D scene on the left; tensions, thesis angles and differences on the right, the other
-    channels in tabs behind the metrics."""
+    channels in tabs behind the metrics; ``extra_views`` in tabs before all that."""
     channels = list(dict.fromkeys(c for r in runs for c in _columns(r.traj)))
     main = [c for c in MAIN_PLOTS if c in channels]
     rest = [c for c in channels if c not in main]
@@ -333,5 +345,7 @@ def _blueprint(runs: list[_Run], diffs: list) -> rrb.Blueprint:
         layout = rrb.Horizontal(scene, right, column_shares=[3, 2])
     else:
         layout = right
+    if extra_views:
+        layout = rrb.Tabs(*extra_views, layout)
     return rrb.Blueprint(layout, rrb.BlueprintPanel(state="collapsed"), rrb.SelectionPanel(state="collapsed"),
                          rrb.TimePanel(timeline=TIMELINE, state="collapsed"))

@@ -46,7 +46,7 @@ def mujoco_recommendation(ctx: CaseContext):
     space = load_space(path)
     rows = run_chunk(str(path), 0, space.size)
     top = best(rows, space.measure, space.objective)
-    result = mujoco_check(space, top["values"])
+    result = mujoco_check(space, [top["values"]])[0].entry
     out = []
     for m in result["modes"]:
         out.append(check(f"{m['axis']} ({m['motion']}, {m['predicted']:.6f} s): MuJoCo period vs sweep",

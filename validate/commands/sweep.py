@@ -11,7 +11,8 @@ empty where not measured or not identifiable), ``clearance`` (m above the floor)
 runs the K best configurations in MuJoCo (:mod:`validate.studies.sweep_check`) and fails (exit 1) on a
 disagreement over 1e-6. ``--png`` adds ``DIR/sweep.png``:
 the objective over the two most varied axes (the best over the others), infeasible points marked, and the
-Pareto front. The evaluation is :mod:`bifilar.sweep`.
+Pareto front; ``--rerun`` adds ``DIR/sweep.rrd``, the table and the check's motions
+(:mod:`validate.studies.sweep_record`). The evaluation is :mod:`bifilar.sweep`.
 """
 
 from __future__ import annotations
@@ -46,6 +47,9 @@ def add_parser(subparsers):
     p.add_argument("--check-mujoco", type=whole_number("--check-mujoco", 0, 100), default=0, metavar="K",
                    help="run the K best configurations in MuJoCo and compare periods and tensions "
                         "(exit 1 if any differs by more than 1e-6; default 0: no check)")
+    p.add_argument("--rerun", action="store_true",
+                   help="also write DIR/sweep.rrd: the table and the MuJoCo check's motions "
+                        "(open: rerun DIR/sweep.rrd)")
     return p
 
 
@@ -148,10 +152,12 @@ def run(args) -> int:
     from bifilar.sweep.run import run as run_sweep
     from bifilar.sweep.space import load_space
 
-    from ..trajectory import atomic_write_text
+    from ..trajectory import atomic_write_text, check_writable
 
-    space = load_space(args.space)
     out = Path(args.out)
+    if args.rerun:
+        check_writable(out / "sweep.rrd")  # a bad path fails now, not after the sweep
+    space = load_space(args.space)
     out.mkdir(parents=True, exist_ok=True)
     jobs = args.jobs or os.cpu_count() or 1
     start = time.perf_counter()
@@ -172,6 +178,7 @@ def run(args) -> int:
             bar.close()
     seconds = time.perf_counter() - start
     data = summary(space, rows, seconds)
+    checked = []
     if args.check_mujoco:
         from bifilar.sweep.choose import objective
 
@@ -179,11 +186,16 @@ def run(args) -> int:
 
         ranked = sorted((r for r in rows if math.isfinite(objective(r, space.measure, space.objective))),
                         key=lambda r: objective(r, space.measure, space.objective))
-        data["mujoco_check"] = [check(space, r["values"]) for r in ranked[: args.check_mujoco]]
+        checked = check(space, [r["values"] for r in ranked[: args.check_mujoco]])
+        data["mujoco_check"] = [c.entry for c in checked]
     atomic_write_text(out / "sweep.csv", csv_text(list(space.axes), rows))
     atomic_write_text(out / "summary.json", json.dumps(data, indent=1, allow_nan=False) + "\n")
     if args.png:
         figure(space, rows, out / "sweep.png")
+    if args.rerun:
+        from ..studies.sweep_record import record_sweep
+
+        record_sweep(out / "sweep.rrd", space, rows, checked)
     shutil.rmtree(out / ".chunks", ignore_errors=True)  # the sweep is whole: the resume files are spent
     failed = [c for c in data["mujoco_check"] if not c["ok"]]
     top = data["best"]
@@ -192,7 +204,7 @@ def run(args) -> int:
                  f"{100 * top['objective']:.3g} %, peak tension {top['tension_peak']:.4g} N")
     print(f"sweep {Path(args.space).name}: {data['n']} configurations, {data['feasible']} feasible, "
           f"{seconds:.1f} s on {1 if args.scheduler is None and jobs == 1 else jobs} worker(s); {best_text}; "
-          f"wrote {out / 'sweep.csv'}, {out / 'summary.json'}")
+          f"wrote {out / 'sweep.csv'}, {out / 'summary.json'}" + (f", {out / 'sweep.rrd'}" if args.rerun else ""))
     if data["mujoco_check"]:
         worst = max(c["period_rel_error"] for c in data["mujoco_check"])
         print(f"MuJoCo check of the {len(data['mujoco_check'])} best: largest period difference {worst:.2e}"

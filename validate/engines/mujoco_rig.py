@@ -9,7 +9,8 @@ derived quantities in ``mjData`` (``efc_force``, ``ten_length``, ``qacc``) are t
 start of the last step, one step before the sampled ``qpos``; so each sample calls ``mj_forward`` to
 recompute them at the sampled state. That costs one forward pass per sample (1/250 of the work at the
 chosen step) and changes nothing in the trajectory: the next ``mj_step`` repeats that same forward
-pass. How velocities are started and read is explained in :func:`simulate`.
+pass. How velocities are started and read is explained in :func:`simulate`. :func:`run_batch` steps
+many runs at once through ``mujoco.rollout`` on every core, sampled by the same code.
 
 Refused before a step is taken: a rig whose two cable rows are so unequally loaded that MuJoCo's soft
 constraint is ill-conditioned there (:func:`row_coupling`; a slender body), and a run of more than
@@ -18,11 +19,15 @@ constraint is ill-conditioned there (:func:`row_coupling`; a slender body), and 
 
 from __future__ import annotations
 
+import os
 import time
+from collections.abc import Sequence
 from contextlib import contextmanager
+from dataclasses import dataclass
 from functools import partial
 
 import mujoco
+from mujoco import rollout
 import numpy as np
 from scipy.spatial.transform import Rotation
 
@@ -41,6 +46,9 @@ MAX_STEPS = 25_000_000  # 1000 s at 4e-5 s; ~3 min at the ~1.5e5 steps/s measure
 # a 10 kg body on 2 m wires, I = [Ix, 1, 1], 0.2 s at rest: coupling 13-417 (Ix 0.1-0.003) tensions
 # within 2e-8; 1251 (Ix 1e-3) 6e-5; 4167 (Ix 3e-4) 3.5 %; 1.25e5 (Ix 1e-5) 63 % (the shipped rigs: 1.6-2.2).
 MAX_ROW_COUPLING = 500.0
+# Numbers one mujoco.rollout call of run_batch may record (128 MB): rollout keeps the state (14 numbers
+# for one body) after every step, so this holds four runs of 10 s at 4e-5 s whole (see run_batch).
+ROLLOUT_FLOATS = 1 << 24
 
 
 def run(rig: Rig, duration: float, dt_out: float = 0.01, rtol: float = 1e-10, state: State | None = None, *,
@@ -49,6 +57,98 @@ def run(rig: Rig, duration: float, dt_out: float = 0.01, rtol: float = 1e-10, st
     ``dt_out`` s, within ``max_seconds`` of wall time. ``rtol`` is ignored: MuJoCo's accuracy is set by
     ``numerics``. A rig whose cable rows are ill-conditioned (:func:`row_coupling` above
     :data:`MAX_ROW_COUPLING`) is refused as a :class:`RigError` on ``body.inertia``."""
+    model, start = _prepare(rig, duration, state, cables, numerics)
+    return simulate(model, rig, start, duration, dt_out, cables, numerics.staggered, max_seconds)
+
+
+@dataclass(frozen=True)
+class BatchRun:
+    """One run of :func:`run_batch`: the arguments of :func:`run` that may differ from run to run."""
+
+    rig: Rig
+    duration: float  # s
+    dt_out: float  # s, a whole number of MuJoCo steps
+    state: State | None = None  # None: the rig's initial state
+
+
+def run_batch(runs: Sequence[BatchRun], *, cables: str = "tendon", numerics: Numerics = CHOSEN,
+              nthread: int | None = None, max_seconds: float | None = None) -> list[Trajectory]:
+    """:func:`run` for every run of ``runs``, stepped together by :func:`mujoco.rollout` on ``nthread``
+    threads (default: every core), one ``MjData`` per thread; each run has its own model, duration and
+    sampling. rollout records the state after every step; the sampled ones get a forward pass here,
+    like in :func:`simulate`. A run that raises a MuJoCo warning stops in rollout (its time stops),
+    which fails the batch as :class:`IntegrationError`.
+
+    The same model, start, steps and samples as :func:`run`, so the same numbers (bit for bit in the
+    positions, measured in ``tests/test_sweep_check.py``), with one proviso: rollout takes the solver's
+    warm start (the previous step's acceleration) as an input and does not return it. A run is
+    therefore rolled out in one call whenever it fits :data:`ROLLOUT_FLOATS`: the runs go longest
+    first, one per thread to a call (a call steps all its runs as far as its longest, so runs of like
+    length go together), as many as fit; a longer run goes in pieces, each started from the
+    acceleration of its latest sample. The Newton solver converges in one iteration from either warm
+    start, to rounding, but an occasional last bit of a velocity differs, and the soft cable rows turn
+    a last bit of position (~1e-16 m) into ~1e-7 N of tension."""
+    prepared = [_prepare(r.rig, r.duration, r.state, cables, numerics) for r in runs]
+    started = time.monotonic()
+    samplers = [_Sampler(model, r.rig, start, r.duration, r.dt_out, cables, numerics.staggered)
+                for (model, start), r in zip(prepared, runs)]
+    if not samplers:
+        return []
+    sizes = {(s.model.nq, s.model.nv, s.model.nbody, s.model.ntendon, s.model.neq) for s in samplers}
+    if len(sizes) > 1:  # one MjData per thread serves every model: their sizes must agree
+        raise ValueError(f"run_batch: the runs' models differ in size {sorted(sizes)}; batch rigs of one shape")
+    nstate = mujoco.mj_stateSize(samplers[0].model, _STATE)
+    nthread = (os.cpu_count() or 1) if nthread is None else nthread
+    threads = [mujoco.MjData(samplers[0].model) for _ in range(nthread)]
+    with _quiet_warnings(), rollout.Rollout(nthread=nthread if nthread > 1 else 0) as pool:
+        for s in samplers:
+            s.sample(0)
+        group: list[_Sampler] = []
+        for s in sorted((s for s in samplers if s.n_out > 1), key=lambda s: -s.steps):
+            if group and (len(group) == nthread or (len(group) + 1) * group[0].steps * nstate > ROLLOUT_FLOATS):
+                _roll(pool, threads, group, nstate, started, max_seconds)
+                group = []
+            group.append(s)
+        _roll(pool, threads, group, nstate, started, max_seconds)
+    return [s.trajectory() for s in samplers]
+
+
+_STATE = mujoco.mjtState.mjSTATE_FULLPHYSICS  # what rollout takes and records
+
+
+def _roll(pool: rollout.Rollout, threads: list[mujoco.MjData], group: list[_Sampler], nstate: int,
+          started: float, max_seconds: float | None) -> None:
+    """Step the runs of ``group`` (sample 0 taken) to their ends, sampling them on the way: in one
+    rollout call if it fits :data:`ROLLOUT_FLOATS`, else in pieces (see :func:`run_batch`)."""
+    done = 0  # steps every unfinished run has taken
+    active = group
+    while active:
+        nstep = min(max(ROLLOUT_FLOATS // (nstate * len(active)), 1), max(s.steps for s in active) - done)
+        start = np.empty((len(active), nstate))
+        warm = np.empty((len(active), active[0].model.nv))
+        for i, s in enumerate(active):
+            mujoco.mj_getState(s.model, s.data, start[i], _STATE)
+            warm[i] = s.data.qacc_warmstart  # zero at the start, as in simulate
+        states, _ = pool.rollout([s.model for s in active], threads, start, nstep=nstep, initial_warmstart=warm)
+        for i, s in enumerate(active):
+            h = s.model.opt.timestep
+            for k in range(done // s.nstep + 1, min((done + nstep) // s.nstep, s.n_out - 1) + 1):
+                state = states[i, k * s.nstep - done - 1]
+                if abs(state[0] - k * s.nstep * h) > 0.5 * h:
+                    raise IntegrationError(f"mujoco: a warning stopped the run of {s.rig.name} before t = "
+                                           f"{k * s.dt_out:g} s; the run is not valid (numerics too coarse?)")
+                mujoco.mj_setState(s.model, s.data, state, _STATE)
+                s.sample(k)
+            s.data.qacc_warmstart[:] = s.data.qacc  # the next piece's: see run_batch
+            mujoco.mj_setState(s.model, s.data, states[i, -1], _STATE)
+        done += nstep
+        _check_budget(started, max_seconds, done * active[0].model.opt.timestep)
+        active = [s for s in active if s.steps > done]
+
+
+def _prepare(rig: Rig, duration: float, state: State | None, cables: str,
+             numerics: Numerics) -> tuple[mujoco.MjModel, State]:
+    """The compiled model and the start of a run, refused before a step as :func:`run` says."""
     steps = duration / numerics.timestep
     if steps > MAX_STEPS:
         raise EngineInputError("--duration", f"{duration:g} s is {steps:.3g} MuJoCo steps of {numerics.timestep:g} s, "
@@ -60,7 +160,7 @@ def run(rig: Rig, duration: float, dt_out: float = 0.01, rtol: float = 1e-10, st
         raise RigError(rig.source, "body.inertia", f"MuJoCo's soft cables are ill-conditioned for this body (row "
                        f"coupling {coupling:.3g} > {MAX_ROW_COUPLING:g}: one wire's pull turns the body far more than "
                        "the other's); its tensions would be wrong by percent: use --engine kane")
-    return simulate(model, rig, start, duration, dt_out, cables, numerics.staggered, max_seconds)
+    return model, start
 
 
 def row_coupling(model: mujoco.MjModel, rig: Rig, state: State) -> float:
@@ -140,52 +240,77 @@ def simulate(model: mujoco.MjModel, rig: Rig, state: State, duration: float, dt_
     at that state, from MuJoCo's own J, M and unconstrained acceleration); from the second sample on
     the soft rows' own forces agree with Kane to 2e-7.
     """
-    nstep = round(dt_out / model.opt.timestep)
-    if nstep < 1 or abs(nstep * model.opt.timestep - dt_out) > 1e-9 * dt_out:
-        raise EngineInputError("--dt-out", f"{dt_out:g} s is not a whole number of MuJoCo time steps "
-                               f"({model.opt.timestep:g} s)")
     started = time.monotonic()
-    times = output_grid(duration, dt_out)
-    n_out = len(times)
-    data = mujoco.MjData(model)
-    data.qpos[:], data.qvel[:] = mjcf.state_qpos_qvel(rig, state)
-    half = 0.5 * model.opt.timestep if staggered and model.opt.integrator != mujoco.mjtIntegrator.mjINT_RK4 else 0.0
-    rows = _cable_rows(model, cables)
-    qpos = np.empty((n_out, model.nq))
-    qvel = np.empty((n_out, model.nv))
-    tension = np.empty((n_out, len(rig.wires)))
-    length = np.empty((n_out, len(rig.wires)))
+    run = _Sampler(model, rig, state, duration, dt_out, cables, staggered)
     with _quiet_warnings():  # reported by _check_warnings as one error, not printed by MuJoCo
-        for k in range(n_out):
+        for k in range(run.n_out):
             if k:
-                mujoco.mj_step(model, data, nstep)
-            mujoco.mj_forward(model, data)
-            _check_warnings(data, k * dt_out)
-            if max_seconds is not None and time.monotonic() - started > max_seconds:
-                raise BudgetSpent(f"mujoco: wall-time budget of {max_seconds:g} s spent at t = {k * dt_out:.6g} s")
-            qpos[k] = data.qpos
-            tension[k] = cable_tensions(data, rows) if k else settled_tensions(model, data, cables)
-            length[k] = data.ten_length
-            if k:
-                qvel[k] = data.qvel + half * data.qacc
-            else:
-                qvel[k] = data.qvel
-                data.qvel -= half * data.qacc
-    channels = rig_channels(rig, qpos, qvel)
-    channels["tension"] = tension
-    channels["length_error"] = length - np.array([w.length for w in rig.wires])
-    slack = np.argwhere(tension <= 0.0)
-    meta = {
-        "rig": rig.name,
-        "rig_spec": rig,
-        "cables": cables,
-        "timestep": model.opt.timestep,
-        "integrator": mujoco.mjtIntegrator(model.opt.integrator).name,
-        # (wire, time) of the first sample with a slack wire; the run goes on through slack spells.
-        "first_slack": None if not slack.size else (int(slack[0, 1]) + 1, float(slack[0, 0] * dt_out)),
-    }
-    engine = "mujoco" if cables == "tendon" else "mujoco-eq"
-    return Trajectory(engine, times, channels, meta)
+                mujoco.mj_step(model, run.data, run.nstep)
+            run.sample(k)
+            _check_budget(started, max_seconds, k * dt_out)
+    return run.trajectory()
+
+
+class _Sampler:
+    """The samples of one run, taken from its ``data`` when it holds the stepped state of sample ``k``
+    (:meth:`sample`): the forward pass, the tensions and the velocities that :func:`simulate`
+    describes. Shared by :func:`simulate` and :func:`run_batch`."""
+
+    def __init__(self, model: mujoco.MjModel, rig: Rig, state: State, duration: float, dt_out: float, cables: str,
+                 staggered: bool):
+        self.nstep = round(dt_out / model.opt.timestep)
+        if self.nstep < 1 or abs(self.nstep * model.opt.timestep - dt_out) > 1e-9 * dt_out:
+            raise EngineInputError("--dt-out", f"{dt_out:g} s is not a whole number of MuJoCo time steps "
+                                   f"({model.opt.timestep:g} s)")
+        self.model, self.rig, self.cables, self.dt_out = model, rig, cables, dt_out
+        self.times = output_grid(duration, dt_out)
+        self.n_out = len(self.times)
+        self.steps = (self.n_out - 1) * self.nstep  # MuJoCo steps to the last sample
+        self.data = mujoco.MjData(model)
+        self.data.qpos[:], self.data.qvel[:] = mjcf.state_qpos_qvel(rig, state)
+        integrator = model.opt.integrator
+        self.half = 0.5 * model.opt.timestep if staggered and integrator != mujoco.mjtIntegrator.mjINT_RK4 else 0.0
+        self.rows = _cable_rows(model, cables)
+        self.qpos = np.empty((self.n_out, model.nq))
+        self.qvel = np.empty((self.n_out, model.nv))
+        self.tension = np.empty((self.n_out, len(rig.wires)))
+        self.length = np.empty((self.n_out, len(rig.wires)))
+
+    def sample(self, k: int) -> None:
+        model, data = self.model, self.data
+        mujoco.mj_forward(model, data)
+        _check_warnings(data, k * self.dt_out)
+        self.qpos[k] = data.qpos
+        self.tension[k] = cable_tensions(data, self.rows) if k else settled_tensions(model, data, self.cables)
+        self.length[k] = data.ten_length
+        if k:
+            self.qvel[k] = data.qvel + self.half * data.qacc
+        else:
+            self.qvel[k] = data.qvel
+            data.qvel -= self.half * data.qacc
+
+    def trajectory(self) -> Trajectory:
+        rig, model, tension = self.rig, self.model, self.tension
+        channels = rig_channels(rig, self.qpos, self.qvel)
+        channels["tension"] = tension
+        channels["length_error"] = self.length - np.array([w.length for w in rig.wires])
+        slack = np.argwhere(tension <= 0.0)
+        meta = {
+            "rig": rig.name,
+            "rig_spec": rig,
+            "cables": self.cables,
+            "timestep": model.opt.timestep,
+            "integrator": mujoco.mjtIntegrator(model.opt.integrator).name,
+            # (wire, time) of the first sample with a slack wire; the run goes on through slack spells.
+            "first_slack": None if not slack.size else (int(slack[0, 1]) + 1, float(slack[0, 0] * self.dt_out)),
+        }
+        engine = "mujoco" if self.cables == "tendon" else "mujoco-eq"
+        return Trajectory(engine, self.times, channels, meta)
+
+
+def _check_budget(started: float, max_seconds: float | None, t: float) -> None:
+    if max_seconds is not None and time.monotonic() - started > max_seconds:
+        raise BudgetSpent(f"mujoco: wall-time budget of {max_seconds:g} s spent at t = {t:.6g} s")
 
 
 def _cable_rows(model: mujoco.MjModel, cables: str) -> tuple[int, int]:
