@@ -73,7 +73,9 @@ _RTOL_PER_RAD = 1e-6
 
 def axis_vector(axis) -> np.ndarray:
     """A unit body-frame vector from ``x``, ``y``, ``z`` or any non-zero 3-vector."""
-    e = AXES[axis] if isinstance(axis, str) else np.asarray(axis, dtype=float)
+    if isinstance(axis, str):
+        return AXES[axis].copy()  # already unit
+    e = np.asarray(axis, dtype=float)
     return e / np.linalg.norm(e)
 
 

@@ -27,7 +27,7 @@ apparent moment for a pure rotation.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from functools import lru_cache
 
 import numpy as np
@@ -179,7 +179,9 @@ def _continued(space: Space, rig: Rig, row: Row, guess: Rest) -> bool:
     if not ok:
         return False
     for n, (axis, k) in enumerate(chosen.items()):
-        _record(row, axis, propagate(bases[axis], table[n], inputs(rig, bases[axis].period, rig.uncertainty.period)))
+        values = inp.values.copy()
+        values[-1] = bases[axis].period  # the measured period: the one input that differs between axes
+        _record(row, axis, propagate(bases[axis], table[n], replace(inp, values=values)))
     peak = _peak(NWireModel.from_rig(rig), rest, [shapes[:, k] for k in chosen.values()],
                  [periods[k] for k in chosen.values()], [rot @ ident.axis_vector(a) for a in chosen], space.amplitude)
     row.tension_peak = float(np.nanmax([tensions.max(), peak]))
