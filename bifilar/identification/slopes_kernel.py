@@ -17,7 +17,7 @@ anchor or attachment coordinate, the mass, a COM coordinate; the order of
    quotient is computed by the same arithmetic, so the difference carries no rounding offset.
 
 The same steps with a fresh eigen-solution per input and a full Newton solve agree to ~1e-6 of the
-slope (tests/test_propagation.py). Where the base equilibrium Jacobian is singular (a neutral tilt
+slope (tests/test_propagation_slopes.py). Where the base equilibrium Jacobian is singular (a neutral tilt
 about the line of two attachments) the continuation is not unique and the caller uses the general path.
 """
 
