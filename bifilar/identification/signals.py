@@ -320,6 +320,10 @@ def _bounds(spec: _Spec, p: np.ndarray):
     hi = np.full(len(p), np.inf)
     lo[0] = 0.2 * p[0]
     hi[0] = 5.0 * p[0]
+    # A free oscillation loses energy: both damping coefficients are >= 0. Unbounded, a short window at
+    # nearly constant amplitude cannot tell them apart and lets them cancel (zeta < 0 < quadratic),
+    # which the next, longer window extrapolates into a wrong minimum.
+    lo[1] = lo[2] = 0.0
     if "gain" in spec.names:
         lo[spec.index("gain")] = 0.0
     if "omega2" in spec.names:
