@@ -206,8 +206,14 @@ def invert_period(rig: Rig, axis, period: float, rest: Rest | None = None, p: Pe
         if hit is not None and p.associated(hit[0])[0] == hit[1]:
             found[round(hit[0], 9 - int(np.floor(np.log10(hit[0]))))] = hit
     if not found:
+        k0 = int(np.argmax(p.shares(p.moment0, v)))
+        ends = [p.associated(j) for j in (p.floor + np.exp(np.log(p.moment0 - p.floor) - _REACH),
+                                          p.floor + np.exp(np.log(p.moment0 - p.floor) + _REACH))]
+        low, high = sorted(2.0 * np.pi / np.sqrt(w2_[k_]) for k_, w2_, _ in ends)
         raise RigError(src, "period", f"{period:.9g} s: no moment about {name} within a factor 1e6 of the "
-                                      f"rig's {p.moment0:.6g} kg m^2 gives the mode turning about it this period")
+                                      f"rig's {p.moment0:.6g} kg m^2 gives the mode turning about it this period "
+                                      f"(it spans {low:.9g}..{high:.9g} s there; d ln T / d ln J = "
+                                      f"{0.5 * p.shares(p.moment0, v)[k0]:.2g} at the rig's moment)")
     if len(found) > 1:
         raise RigError(src, "period", f"{period:.9g} s is ambiguous: moments {', '.join(f'{j:.6g}' for j in found)} "
                                       f"kg m^2 about {name} all give it")
