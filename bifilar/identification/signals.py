@@ -20,9 +20,11 @@ The amplitude law f (:class:`AmplitudeLaw`) is the rig's own, not a cubic stand-
 
   lam = bD / (4 H g): the ratio m z'^2 / I is lam omega^2 u^2, so the law needs the geometry only,
   not the mass or the moment. omega is exactly the small-amplitude undamped frequency.
-* ``series``: f = theta (1 + kappa theta^2), kappa = -8 s / 3 reproducing T(A) = T0 (1 + s A^2) of
-  the Kane model (:func:`bifilar.identification.identify.amplitude_coefficient`), for modes that
-  are not a symmetric torsion; right to O(A^2) (its error is the model error it reports).
+* ``series``: f = theta (1 + kappa theta^2 + q theta^4), kappa = -8 s / 3 reproducing T(A) = T0 (1 + s
+  A^2) of the Kane model (:func:`bifilar.identification.identify.amplitude_coefficient`), for modes
+  that are not a symmetric torsion; the quintic q, matched to the Kane model's T(A) / T0 at the
+  record's largest amplitude (:meth:`AmplitudeLaw.matched`), makes it right at both ends of the
+  record's amplitude range, not only to O(A^2).
 * ``linear``: f = theta.
 
 Where the real rig's amplitude dependence differs from the ideal law (wire stretch, finite hooks),
@@ -56,7 +58,7 @@ white noise gives blocks of one, the usual Jacobian covariance.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from numba import njit
@@ -83,6 +85,10 @@ MIN_BLOCKS = 20  # fewer blocks and the block variance itself is too uncertain
 # of the same order: far below the statistical error of any real record.
 _STEPS_PER_PERIOD = 128
 _PERIODOGRAM_SAMPLES = 512  # at most this many samples in a periodogram (starting values only)
+# Matching a series law's quintic to the Kane model's T(A) / T0: the ratio itself is integrated to
+# ~1e-10 (4096 RK4 steps per period), the Kane ratio is timed to ~1e-9; 1e-9 and a few secant steps.
+_MATCH_TOL = 1e-9
+_MATCH_STEPS = 6
 
 
 @dataclass(frozen=True)
@@ -96,6 +102,7 @@ class AmplitudeLaw:
     rho: float = 0.0
     lam: float = 0.0
     s: float = 0.0
+    quintic: float = 0.0  # series law: the theta^5 coefficient of f (1/rad^4), see :meth:`matched`
 
     @classmethod
     def torsion(cls, torsion_rig) -> "AmplitudeLaw":
@@ -118,11 +125,30 @@ class AmplitudeLaw:
             return 1.0
         period = 2.0 * math.pi / omega
         h = period / 4096.0
-        tau = np.arange(0.0, 0.75 * period * (1.0 + 4.0 * abs(self.coefficient(omega)) * amplitude**2), h)
+        stretch = 1.0 + 4.0 * abs(self.coefficient(omega)) * amplitude**2 + 4.0 * abs(self.quintic) * amplitude**4
+        tau = np.arange(0.0, 0.75 * period * stretch, h)
         p = np.array([omega, 0.0, 0.0, amplitude, 0.0, 0.0, 0.0])
-        theta = _response(p, self.kind == "exact", self.rho, self.lam, self._kappa(0.0), tau, h, False)
+        theta = _response(p, self.kind == "exact", self.rho, self.lam, self._kappa(0.0), self.quintic, tau, h, False)
         down = crossing_times(tau, theta, 0.0, rising=False)
         return float(4.0 * down[0] / period) if len(down) else 1.0
+
+    def matched(self, amplitude: float, ratio: float, omega: float) -> "AmplitudeLaw":
+        """This series law with the quintic coefficient that makes its T(A) / T0 at ``amplitude``
+        equal ``ratio`` (the Kane model's, :func:`bifilar.identification.identify.amplitude_ratio`):
+        right at O(A^2) by s and at the record's largest amplitude by the quintic. T(A) / T0 falls by
+        ~(5 / 16) q A^4 as q grows, nearly linearly: secant steps from that estimate."""
+        if self.kind != "series":
+            raise ValueError("only a series law takes a quintic term")
+        law = replace(self, quintic=0.0)
+        step = 16.0 / (5.0 * amplitude**4)
+        q0, r0 = 0.0, law.ratio(amplitude, omega)
+        q1 = q0 + (r0 - ratio) * step
+        for _ in range(_MATCH_STEPS):
+            r1 = replace(law, quintic=q1).ratio(amplitude, omega)
+            if abs(r1 - ratio) < _MATCH_TOL or r1 == r0:
+                break
+            q0, r0, q1 = q1, r1, q1 - (r1 - ratio) * (q1 - q0) / (r1 - r0)
+        return replace(law, quintic=float(q1))
 
     def _kappa(self, excess: float) -> float:
         """The cubic coefficient of f: the series law's own and the fitted excess."""
@@ -192,24 +218,26 @@ class _Spec:
     def index(self, name: str) -> int:
         return self.names.index(name)
 
-    def law_terms(self, p: np.ndarray) -> tuple[bool, float]:
-        """(exact law?, cubic coefficient) at parameters ``p``. A proportional record runs in signal
-        units x, theta = sqrt(gain) x: the law enters as its series, its cubic scaled by gain."""
+    def law_terms(self, p: np.ndarray) -> tuple[bool, float, float]:
+        """(exact law?, cubic coefficient, quintic coefficient) at parameters ``p``. A proportional
+        record runs in signal units x, theta = sqrt(gain) x: the law enters as its O(A^2) series, its
+        cubic scaled by gain."""
         n = self.names
         if self.kind == "proportional":
             gain = p[n.index("gain")] if "gain" in n else 0.0
-            return False, -8.0 / 3.0 * self.law.coefficient(p[0]) * gain
-        return self.law.kind == "exact", self.law._kappa(p[n.index("excess")] if "excess" in n else 0.0)
+            return False, -8.0 / 3.0 * self.law.coefficient(p[0]) * gain, 0.0
+        excess = p[n.index("excess")] if "excess" in n else 0.0
+        return self.law.kind == "exact", self.law._kappa(excess), self.law.quintic
 
     def model(self, p: np.ndarray, tau: np.ndarray, first_only: bool = False, rate_out: bool | None = None) -> np.ndarray:
         """The model signal at ``tau``; ``first_only``: theta (or theta') alone, no offset, drift or
         second mode."""
-        exact, kappa = self.law_terms(p)
+        exact, kappa, kappa5 = self.law_terms(p)
         base = np.array(p[:7], dtype=float)
         if first_only:
             base[5] = base[6] = 0.0
         rate_out = self.kind == "rate" if rate_out is None else rate_out
-        out = _response(base, exact, self.law.rho, self.law.lam, kappa, tau, self.step, rate_out)
+        out = _response(base, exact, self.law.rho, self.law.lam, kappa, kappa5, tau, self.step, rate_out)
         if "omega2" in self.names and not first_only:
             j = self.names.index("omega2")
             w2, a2, c2, s2 = p[j : j + 4]
@@ -527,7 +555,7 @@ def _damped_sinusoid(tau: np.ndarray, y: np.ndarray, omega_d: float) -> np.ndarr
 
 
 @njit(cache=True)
-def _acceleration(theta, rate, omega, zeta, quadratic, exact, rho, lam, kappa):
+def _acceleration(theta, rate, omega, zeta, quadratic, exact, rho, lam, kappa, kappa5):
     w2 = omega * omega
     damping = 2.0 * zeta * omega * rate + quadratic * abs(rate) * rate
     if exact:
@@ -537,28 +565,29 @@ def _acceleration(theta, rate, omega, zeta, quadratic, exact, rho, lam, kappa):
         v = (1.0 - 2.0 * half * half) / r + 0.25 * rho * u * u / r  # cos(theta) / r + ...
         restoring = w2 * u * (1.0 + lam * v * rate * rate) / (1.0 + lam * w2 * u * u) + w2 * kappa * theta**3
     else:
-        restoring = w2 * theta * (1.0 + kappa * theta * theta)
+        t2 = theta * theta
+        restoring = w2 * theta * (1.0 + kappa * t2 + kappa5 * t2 * t2)
     return -damping - restoring
 
 
 @njit(cache=True)
-def _response(p, exact, rho, lam, kappa, tau, h, rate_out):
+def _response(p, exact, rho, lam, kappa, kappa5, tau, h, rate_out):
     """The model signal offset + drift tau + theta (or theta') at the sample times ``tau`` (tau[0] = 0)
     with RK4 steps of ``h``; p = (omega, zeta, quadratic, theta0, rate0, offset, drift, ...)."""
     omega, zeta, quadratic, theta, rate, offset, drift = p[0], p[1], p[2], p[3], p[4], p[5], p[6]
     out = np.empty(tau.shape[0])
-    acc = _acceleration(theta, rate, omega, zeta, quadratic, exact, rho, lam, kappa)
+    acc = _acceleration(theta, rate, omega, zeta, quadratic, exact, rho, lam, kappa, kappa5)
     k, i = 0, 0
     while k < tau.shape[0]:
         r2 = rate + 0.5 * h * acc
-        a2 = _acceleration(theta + 0.5 * h * rate, r2, omega, zeta, quadratic, exact, rho, lam, kappa)
+        a2 = _acceleration(theta + 0.5 * h * rate, r2, omega, zeta, quadratic, exact, rho, lam, kappa, kappa5)
         r3 = rate + 0.5 * h * a2
-        a3 = _acceleration(theta + 0.5 * h * r2, r3, omega, zeta, quadratic, exact, rho, lam, kappa)
+        a3 = _acceleration(theta + 0.5 * h * r2, r3, omega, zeta, quadratic, exact, rho, lam, kappa, kappa5)
         r4 = rate + h * a3
-        a4 = _acceleration(theta + h * r3, r4, omega, zeta, quadratic, exact, rho, lam, kappa)
+        a4 = _acceleration(theta + h * r3, r4, omega, zeta, quadratic, exact, rho, lam, kappa, kappa5)
         theta1 = theta + h / 6.0 * (rate + 2.0 * r2 + 2.0 * r3 + r4)
         rate1 = rate + h / 6.0 * (acc + 2.0 * a2 + 2.0 * a3 + a4)
-        acc1 = _acceleration(theta1, rate1, omega, zeta, quadratic, exact, rho, lam, kappa)
+        acc1 = _acceleration(theta1, rate1, omega, zeta, quadratic, exact, rho, lam, kappa, kappa5)
         if not (abs(theta1) < 1e6 and abs(rate1) < 1e12):  # a diverging trial step: stop, flat
             while k < tau.shape[0]:
                 out[k] = offset + drift * tau[k] + (rate if rate_out else theta)

@@ -19,7 +19,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.stats import chi2
 
-from bifilar.identification.identify import AXES, Pencil, amplitude_coefficient, axis_vector, invert_period, pencil
+from bifilar.identification.identify import (AXES, Pencil, amplitude_coefficient, amplitude_ratio, axis_vector,
+                                             invert_period, linear_period, pencil)
 from bifilar.identification.records import Record
 from bifilar.identification.signals import EXCESS_PRIOR, AmplitudeLaw, OscillationFit, fit_record
 from bifilar.motion import lagrange
@@ -27,17 +28,25 @@ from bifilar.rig import Rig, RigError
 
 CONSISTENCY = 0.99  # chi^2 quantile above which the trials are called inconsistent
 _LAW_RTOL = 1e-3  # a series law this close to the one fitted with does not change the fit
+# Below this amplitude (rad) the series law's O(A^4) error, ~s^2 A^4, is under 1e-6: no quintic.
+_MATCH_FROM = 0.1
 
 
-def law_for(rig: Rig, axis) -> AmplitudeLaw:
+def law_for(rig: Rig, axis, amplitude: float | None = None) -> AmplitudeLaw:
     """The exact 1-DOF torsion law for the vertical axis of a symmetric rig, else the Kane model's
-    period-amplitude series at the rig's moment (module docstring of :mod:`.signals`)."""
+    period-amplitude series at the rig's moment (module docstring of :mod:`.signals`), right at
+    O(A^2); with the record's largest ``amplitude`` (rad) its quintic is matched to the Kane model's
+    T(A) / T0 there (:meth:`AmplitudeLaw.matched`), so that the law holds over the record's range."""
     if np.allclose(axis_vector(axis), AXES["z"]):
         try:
             return AmplitudeLaw.torsion(lagrange.from_rig(rig))
         except RigError:
             pass  # not a symmetric torsion: the Kane series below
-    return AmplitudeLaw("series", s=amplitude_coefficient(rig, axis))
+    law = AmplitudeLaw("series", s=amplitude_coefficient(rig, axis))
+    if amplitude is not None and amplitude > _MATCH_FROM:
+        omega = 2.0 * math.pi / linear_period(rig, axis)
+        law = law.matched(amplitude, amplitude_ratio(rig, axis, amplitude), omega)
+    return law
 
 
 @dataclass(frozen=True)
@@ -65,8 +74,8 @@ def fit_trial(rig: Rig, axis, record: Record, p: Pencil | None = None, excess_pr
         fit = fit_record(record, law, excess_prior=excess_prior)
         found = invert_period(rig, axis, fit.period, p=p)
         if law.kind == "series":
-            better = law_for(found.rig, axis)
-            if abs(better.s - law.s) > _LAW_RTOL * abs(law.s):
+            better = law_for(found.rig, axis, fit.amplitude[0] if fit.amplitude else None)
+            if abs(better.s - law.s) > _LAW_RTOL * abs(law.s) or better.quintic != law.quintic:
                 fit = fit_record(record, better, excess_prior=excess_prior)
                 found = invert_period(rig, axis, fit.period, p=p)
     except RigError as exc:
