@@ -159,3 +159,18 @@ def test_dropped_vertical_energy_on_the_issue_rig():
 def test_amplitude_beyond_reach_is_refused():
     with pytest.raises(ValueError, match="amplitude"):
         L.period(PLATE, PLATE.max_amplitude, True)
+
+
+def test_from_rig_reads_a_symmetric_trifilar_as_the_same_law():
+    """Three wires on one circle (R = 0.3 m, vertical, L = 1.5 m): the law with b = D = 2R. Its linear
+    period is the N-wire linearisation's 2 pi sqrt(L I / (M g R^2)) to rounding, and a platform with
+    its COM off the axis is refused (the torsion would swing)."""
+    from bifilar.identification.identify import linear_period as modes_period
+
+    tri = rig("trifilar")
+    torsion = L.from_rig(tri)
+    assert (torsion.hook_span, torsion.attach_span) == pytest.approx((0.6, 0.6), rel=1e-12)
+    assert L.linear_period(torsion) == pytest.approx(modes_period(tri, "z"), rel=1e-13)
+    with pytest.raises(RigError) as err:
+        L.from_rig(rig("trifilar_offset"))
+    assert err.value.field == "body.com"

@@ -1,4 +1,5 @@
-"""One-degree-of-freedom torsion models of a symmetric bifilar rig (seed 000, ch. 5.2 and 6.2).
+"""One-degree-of-freedom torsion models of a symmetric bifilar rig (seed 000, ch. 5.2 and 6.2), and of
+a symmetric platform on N wires, which obeys the same law (:func:`from_rig`).
 
 The rig: two wires of length ``l`` from hooks ``b`` apart to attachments ``D`` apart, the attachments
 level, the centre of mass on the vertical through their midpoint and the vertical a principal axis of
@@ -96,29 +97,51 @@ def from_rig(rig: Rig) -> TorsionRig:
     """The torsion model of a rig file, which must be symmetric as the module docstring says.
 
     The rest pose is taken to be the body frame translated (as in ``models/rigs/plate.toml``): the
-    attachments level in the body frame, the hooks level in the world, the two spans parallel.
+    attachments level in the body frame, the hooks level in the world. Two wires: the two spans
+    parallel. Any number N >= 2: every anchor at one radius R_a from the anchors' centroid, every
+    attachment at one radius R_b from theirs, each anchor in the direction of its attachment; each
+    attachment's horizontal distance to its hook is then r^2 = (R_a - R_b)^2 + 4 R_a R_b sin^2(theta/2),
+    the module's law with b = 2 R_a and D = 2 R_b. Turned about the vertical the body stays level and
+    on the axis: the static tensions balance the weight with no horizontal resultant (the COM on the
+    axis: sum t_i e_i = 0 for the unit offsets e_i), and every wire keeps the same inclination, so the
+    tensions stay in proportion and their horizontal parts still cancel (N = 2: the half turn).
     """
     src = rig.source
-    if len(rig.wires) != 2:
-        raise RigError(src, "wire", f"the torsion models need exactly two wires, found {len(rig.wires)}")
-    w1, w2 = rig.wires
-    if not math.isclose(w1.length, w2.length, rel_tol=_SYMMETRY_RTOL):
-        raise RigError(src, "wire[2].length", f"{w2.length:g} m differs from wire[1].length {w1.length:g} m")
-    hooks, attach = w1.anchor - w2.anchor, w1.attach - w2.attach
-    b, d = float(np.hypot(*hooks[:2])), float(np.hypot(*attach[:2]))
-    if abs(hooks[2]) > _SYMMETRY_RTOL * b:
-        raise RigError(src, "wire[2].anchor", "not at the height of wire[1].anchor")
-    if abs(attach[2]) > _SYMMETRY_RTOL * d:
-        raise RigError(src, "wire[2].attach", "not at the height of wire[1].attach (body frame)")
-    if abs(hooks[0] * attach[1] - hooks[1] * attach[0]) > _SYMMETRY_RTOL * b * d or hooks[:2] @ attach[:2] <= 0:
-        raise RigError(src, "wire", "the hook span and the attachment span are not parallel at rest")
-    arm = rig.com - 0.5 * (w1.attach + w2.attach)
-    if math.hypot(arm[0], arm[1]) > _SYMMETRY_RTOL * d:
-        raise RigError(src, "body.com", "not on the vertical through the midpoint of the attachments")
+    n = len(rig.wires)
+    if n < 2:
+        raise RigError(src, "wire", f"the torsion models need at least two wires, found {n}")
+    w1 = rig.wires[0]
+    anchors = np.array([w.anchor for w in rig.wires])
+    attach = np.array([w.attach for w in rig.wires])
+    for i, w in enumerate(rig.wires[1:], start=2):
+        if not math.isclose(w.length, w1.length, rel_tol=_SYMMETRY_RTOL):
+            raise RigError(src, f"wire[{i}].length", f"{w.length:g} m differs from wire[1].length {w1.length:g} m")
+    hooks = anchors[:, :2] - anchors[:, :2].mean(axis=0)
+    arms = attach[:, :2] - attach[:, :2].mean(axis=0)
+    r_a, r_b = np.linalg.norm(hooks, axis=1), np.linalg.norm(arms, axis=1)
+    for i in range(1, n):
+        if abs(anchors[i, 2] - anchors[0, 2]) > _SYMMETRY_RTOL * r_a[0]:
+            raise RigError(src, f"wire[{i + 1}].anchor", "not at the height of wire[1].anchor")
+        if abs(attach[i, 2] - attach[0, 2]) > _SYMMETRY_RTOL * r_b[0]:
+            raise RigError(src, f"wire[{i + 1}].attach", "not at the height of wire[1].attach (body frame)")
+        if not math.isclose(r_a[i], r_a[0], rel_tol=_SYMMETRY_RTOL):
+            raise RigError(src, f"wire[{i + 1}].anchor", f"{r_a[i]:g} m from the anchors' centroid, wire[1]'s "
+                                                         f"{r_a[0]:g} m: not on one circle")
+        if not math.isclose(r_b[i], r_b[0], rel_tol=_SYMMETRY_RTOL):
+            raise RigError(src, f"wire[{i + 1}].attach", f"{r_b[i]:g} m from the attachments' centroid, wire[1]'s "
+                                                         f"{r_b[0]:g} m: not on one circle")
+    for i in range(n):
+        if abs(hooks[i, 0] * arms[i, 1] - hooks[i, 1] * arms[i, 0]) > _SYMMETRY_RTOL * r_a[0] * r_b[0] or \
+                hooks[i] @ arms[i] <= 0:
+            raise RigError(src, "wire", f"wire[{i + 1}]'s anchor is not in the direction of its attachment from "
+                                        "the centroids at rest (the spans are not parallel)")
+    arm = rig.com[:2] - attach[:, :2].mean(axis=0)
+    if math.hypot(arm[0], arm[1]) > _SYMMETRY_RTOL * r_b[0]:
+        raise RigError(src, "body.com", "not on the vertical through the centroid of the attachments")
     inertia = rig.inertia
     if math.hypot(inertia[0, 2], inertia[1, 2]) > _SYMMETRY_RTOL * inertia[2, 2]:
         raise RigError(src, "body.inertia", "the vertical is not a principal axis: torsion would couple to swing")
-    return TorsionRig(rig.mass, float(inertia[2, 2]), w1.length, b, d, rig.gravity)
+    return TorsionRig(rig.mass, float(inertia[2, 2]), w1.length, float(2.0 * r_a[0]), float(2.0 * r_b[0]), rig.gravity)
 
 
 def _reach(rig: TorsionRig, theta):

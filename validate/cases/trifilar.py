@@ -22,6 +22,7 @@ from dataclasses import replace
 import numpy as np
 from scipy.integrate import quad
 
+from bifilar.motion import lagrange
 from bifilar.motion.modes import linearize
 
 from ..assets import rig
@@ -88,6 +89,10 @@ def closed_form(ctx: CaseContext):
         exact = torsion_period(r.mass, I, R, L, r.gravity, amplitude)
         out.append(check(f"kane (N-wire) period at {amplitude} rad vs exact quadrature", abs(measured / exact - 1.0),
                          PERIOD_TOL, "integrator rtol 1e-10 and crossing refinement"))
+    torsion = lagrange.from_rig(r)  # the bifilar's 1-DOF law with b, D twice the radii (the fit's exact law)
+    out.append(check("lagrange exact period at 0.5 rad (from_rig, b = D = 2R) vs this quadrature",
+                     abs(lagrange.period(torsion, 0.5, vertical_ke=True) / torsion_period(r.mass, I, R, L, r.gravity, 0.5)
+                         - 1.0), 1e-12, "two quadratures of one energy integral, each to 1e-13"))
     out.append(check("quadrature at 1e-6 rad vs closed form", abs(torsion_period(r.mass, I, R, L, r.gravity, 1e-6) / closed - 1.0),
                      1e-10, "the quadrature's small-amplitude limit (amplitude correction ~1e-13)"))
     return out
