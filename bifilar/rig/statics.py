@@ -3,7 +3,9 @@
 A pose is the COM position ``com`` (world frame, m) and the rotation matrix ``rotation`` (body frame to
 world frame). Both engines start from :func:`initial_state`, so that they integrate the same motion:
 
-1. the rest pose: the minimum of the potential ``m g z_com`` with every wire at its length, polished
+1. the rest pose: the minimum of the potential ``m g z_com`` with every wire at its length (SLSQP from
+   the file's orientation and, for a body frame turned far from the way the body hangs, from that
+   orientation too: the lowest equilibrium found), polished
    by Newton's method on the equilibrium equations (force and moment balance, wire lengths), whose
    unknowns include the tensions;
 2. the body rotated about its COM by ``rig.initial_rotation`` (rotation vector, world frame);
@@ -33,6 +35,8 @@ _NEWTON_ITERATIONS = 30
 _RESIDUAL = 1e-12
 # Constraint rows whose singular value is below this fraction of the largest are dependent.
 NULL_RTOL = 1e-9
+# A body frame turned more than this (rad) from the way the body hangs gets a second SLSQP start.
+_FAR_START = np.radians(20.0)
 # An omega^2 below -this fraction of the largest is a real instability, not rounding.
 NEUTRAL_SLACK = 1e-9
 
@@ -157,11 +161,48 @@ def _stable(rig: Rig, rest: Rest) -> bool:
 
 
 def _global_rest_pose(rig: Rig) -> Rest:
-    """The rest pose without a guess: SLSQP on the potential, then :func:`_polish`."""
+    """The rest pose without a guess: SLSQP on the potential from the file's orientation, then
+    :func:`_polish`; and, where the body frame is turned far from the way the body hangs (the
+    orientation that best lays the attachments under their anchors, :func:`_hanging_orientation`),
+    from that orientation too. Of the stable equilibria found the lowest (least potential) is the rest
+    pose: from a far start SLSQP can settle in a higher, twisted equilibrium (wires crossed) that is
+    stable too. Ties keep the file's orientation's."""
+    starts = [np.eye(3)]
+    hanging = _hanging_orientation(rig)
+    if Rotation.from_matrix(hanging).magnitude() > _FAR_START:
+        starts.append(hanging)
+    found, first_error = [], None
+    for start in starts:
+        try:
+            found.append(_search(rig, start))
+        except RigError as exc:
+            first_error = first_error or exc
+    if not found:
+        raise first_error
+    lowest = min(r.com[2] for r in found)
+    return next(r for r in found if r.com[2] <= lowest + 1e-9 * rig_scale(rig))
+
+
+def _hanging_orientation(rig: Rig) -> np.ndarray:
+    """The rotation (body -> world) that best maps the attachments to points hanging straight under
+    their anchors, each by its wire's length, and the COM under their centroid by its body-frame
+    distance from the attachments' centroid (Kabsch: the SVD of the points' cross-covariance)."""
+    body = np.array([w.attach for w in rig.wires] + [rig.com])
+    under = anchors(rig) - np.outer(lengths(rig), [0.0, 0.0, 1.0])
+    drop = np.linalg.norm(rig.com - body[:-1].mean(axis=0))
+    world = np.vstack([under, under.mean(axis=0) - [0.0, 0.0, drop]])
+    u, _, vt = np.linalg.svd((world - world.mean(axis=0)).T @ (body - body.mean(axis=0)))
+    d = np.sign(np.linalg.det(u @ vt)) or 1.0
+    return u @ np.diag([1.0, 1.0, d]) @ vt
+
+
+def _search(rig: Rig, start: np.ndarray) -> Rest:
+    """SLSQP on the potential from the body turned by ``start`` (body -> world), then :func:`_polish`
+    and the checks of :func:`rest_pose`."""
     scale = rig_scale(rig)
     # Start slightly turned: a symmetric start can be a stationary point that is not a minimum
     # (a body balanced upside down); the minimiser must see a gradient to roll off it.
-    rotation0 = Rotation.from_rotvec([0.03, 0.02, 0.01]).as_matrix()
+    rotation0 = Rotation.from_rotvec([0.03, 0.02, 0.01]).as_matrix() @ start
     guess = anchors(rig).mean(axis=0) - np.array([0.0, 0.0, lengths(rig).mean()])
     guess = guess - (np.array([w.attach for w in rig.wires]).mean(axis=0) - rig.com)
     try:
