@@ -286,3 +286,20 @@ def test_boat_sweep_files_load_as_the_suspension_hangs_the_boat():
     low, _ = parts_lowest(s.parts, rest.com - rest.rotation @ rig.com, rest.rotation)
     assert row.clearance == pytest.approx(low[0] + 6.5, abs=1e-9)  # the foils, not the inertia box
     assert row.clearance < lowest_point(rig, rest) + 6.5 - 0.3  # the box ends ~0.55 m higher
+
+
+def test_resume_digest_follows_every_file_the_sweep_reads(tmp_path):
+    """A boat sweep reads its suspension file and that file's parts file: a changed part mass is a
+    different sweep, whose saved chunks must not be resumed."""
+    import shutil
+
+    from bifilar.sweep.run import digest
+    from validate.assets import MODELS
+
+    folder = tmp_path / "solar_boat"
+    shutil.copytree(MODELS / "solar_boat", folder)
+    before = digest(str(folder / "configurations.toml"), 64)
+    parts = folder / "parts.toml"
+    parts.write_text(parts.read_text().replace("mass = 15.0", "mass = 15.5", 1))
+    assert digest(str(folder / "configurations.toml"), 64) != before
+    assert digest(str(folder / "configurations.toml"), 64) == digest(str(folder / "configurations.toml"), 64)

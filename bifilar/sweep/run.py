@@ -13,6 +13,7 @@ import hashlib
 import json
 import math
 import os
+import pickle
 import tempfile
 from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
@@ -75,10 +76,10 @@ def _evaluate_range(path: str, start: int, stop: int) -> list[dict]:
 
 
 def digest(path: str, chunk: int) -> str:
-    """Identifies the sweep (its file, the base rig's file, the chunk size) for resuming."""
-    space = load_space(path)
+    """Identifies the sweep for resuming: its file, everything loaded from it and the files it names
+    (the base rig, or the suspension and its parts: the loaded space, pickled), and the chunk size."""
     h = hashlib.sha256(Path(path).read_bytes())
-    h.update(Path(space.rig.source).read_bytes())
+    h.update(pickle.dumps(load_space(path), protocol=5))
     h.update(str(chunk).encode())
     return h.hexdigest()[:16]
 
