@@ -256,9 +256,7 @@ def test_attach_inset_moves_both_attachments_in_from_the_base():
     ('rig = "rig.toml"\nsuspension = "rig.toml"\n[vary]\nwire_length = [1.0]\n', "rig"),
 ])
 def test_bad_points_are_one_line_exit_2(tmp_path, capsys, space, field):
-    path = _write(tmp_path, space)
-    code, out, err = _cli(capsys, "sweep", path, "--out", tmp_path / "out")
-    assert code == 2 and out == "" and err.count("\n") == 1 and field in err, err
+    test_bad_sweep_files_are_one_line_exit_2(tmp_path, capsys, space, field)
 
 
 def test_boat_sweep_files_load_as_the_suspension_hangs_the_boat():

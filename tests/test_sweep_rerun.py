@@ -13,23 +13,8 @@ from validate.cli import main
 from validate.recording import SLACK_RGB
 from validate.studies.sweep_check import CYCLES
 
-RIG = """name = "parallel_unc"
-[body]
-mass = 2.0
-inertia = [0.02, 0.05, 0.06]
-[[wire]]
-anchor = [-0.2, 0.0, 1.5]
-attach = [-0.2, 0.0, 0.0]
-length = 1.5
-[[wire]]
-anchor = [0.2, 0.0, 1.5]
-attach = [0.2, 0.0, 0.0]
-length = 1.5
-[uncertainty]
-length = 2e-3
-mass = 1e-2
-period = 3e-3
-"""
+from test_sweep import PARALLEL as RIG  # the vertical-wire rig with an [uncertainty] of the sweep tests
+
 # Wires of 0.1 m cannot reach attachments 0.4 m apart from anchors 1.0 m apart: one infeasible row.
 SPACE = 'rig = "rig.toml"\n[vary]\nanchor_span = [0.4, 1.0]\nwire_length = [0.1, 0.8]\n[measure]\naxes = ["z"]\n'
 
