@@ -1,6 +1,7 @@
 """Every class of bad rig file gets one line naming file, field and problem, and exit status 2."""
 
 import json
+import tomllib
 
 import numpy as np
 import pytest
@@ -196,3 +197,17 @@ def test_the_csv_reads_back_as_written(tmp_path, capsys):
     np.testing.assert_array_equal(back.t, direct.t)  # repr() of floats round-trips exactly
     for name in ("com", "quat", "tension", "length_error"):
         np.testing.assert_array_equal(back[name], direct[name])
+
+
+def test_every_pair_of_wires_must_close_its_loop(tmp_path, capsys):
+    """The trifilar platform with wire 3's attachment moved 3.5 m out: wires 1-2 close their loop, but
+    wires 1 and 3 cannot (attachment span 3.81 m > 0.52 + 1.5 + 1.5 m): one line naming that pair."""
+    text = (RIGS / "trifilar.toml").read_text()
+    data = tomllib.loads(text)
+    attach = data["wire"][2]["attach"]
+    path = tmp_path / "far.toml"
+    path.write_text(text.replace(f"attach = [{attach[0]!r}, {attach[1]!r}, {attach[2]!r}]",
+                                 f"attach = [-3.5, {attach[1]!r}, {attach[2]!r}]"))
+    assert main(["modes", str(path)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "no taut pose" in err and "wires 1 and 3" in err, err

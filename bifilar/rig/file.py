@@ -170,28 +170,32 @@ def rig_from_dict(data: dict, source: str = "<memory>", default_name: str = "rig
 
 
 def check_reachable(rig: Rig) -> None:
-    """Raise unless the two wires, the anchor span and the attachment span can close a loop.
+    """Raise unless every pair of wires, their anchor span and their attachment span can close a loop.
 
-    The loop anchor A -> attach -> attach -> anchor B is a quadrilateral with sides |AB|, l, b', l';
-    a taut pose exists only if no side is longer than the sum of the other three (distinct
-    attachment points are checked with the ranges, :mod:`bifilar.rig.ranges`).
+    In any taut pose, anchor A_i -> attach P_i -> attach P_j -> anchor A_j is a closed quadrilateral with
+    sides |A_i A_j|, L_i, |P_i P_j| (fixed in the body) and L_j; a taut pose exists only if, for every
+    pair, no side is longer than the sum of the other three (distinct attachment points are checked
+    with the ranges, :mod:`bifilar.rig.ranges`). Necessary, not sufficient, for three or more wires.
     """
-    w1, w2 = rig.wires[0], rig.wires[1]
-    span_top = float(np.linalg.norm(w1.anchor - w2.anchor))
-    span_body = float(np.linalg.norm(w1.attach - w2.attach))
-    sides = {"anchor span": span_top, "wire[1].length": w1.length,
-             "attachment span": span_body, "wire[2].length": w2.length}
+    for i in range(len(rig.wires)):
+        for j in range(i + 1, len(rig.wires)):
+            _check_loop(rig, i, j)
+
+
+def _check_loop(rig: Rig, i: int, j: int) -> None:
+    wi, wj = rig.wires[i], rig.wires[j]
+    pair = "" if len(rig.wires) == 2 else f" of wires {i + 1} and {j + 1}"  # named where not implied
+    sides = {"anchor span": float(np.linalg.norm(wi.anchor - wj.anchor)), f"wire[{i + 1}].length": wi.length,
+             "attachment span": float(np.linalg.norm(wi.attach - wj.attach)), f"wire[{j + 1}].length": wj.length}
     total = sum(sides.values())
     for label, side in sides.items():
         if side >= (total - side) * (1.0 - 1e-9):  # equal is a flat loop: no sag, infinite tension
             raise RigError(
                 rig.source,
                 "wire",
-                f"no taut pose: the {label} ({side:.6g} m) is not shorter than the sum of the other three "
+                f"no taut pose: the {label}{pair if 'span' in label else ''} ({side:.6g} m) is not shorter than the sum of the other three "
                 f"sides of the anchor-wire-body loop ({total - side:.6g} m)",
             )
-
-
 
 
 MIN_REST_SHARE = 1e-6  # of the weight: a wire carrying less at rest is slack to rounding
