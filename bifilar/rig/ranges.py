@@ -24,7 +24,14 @@ RANGES = {
     "body.mass": (1e-3, 1e6, "kg", "from a gram to a thousand tonnes"),
     "wire[i].length": (1e-3, 1e3, "m", "from a millimetre to a kilometre"),
     "coordinates": (-1e4, 1e4, "m", "every component of anchor, attach and com"),
+    "air.density": (1e-3, 2e3, "kg/m^3", "from thin air to twice water's"),
+    "air.viscosity": (0.0, 10.0, "Pa s", "0 (inviscid) to ten thousand times water's"),
+    "air.drag": (0.0, 100.0, "", "MuJoCo's coefficients are O(1)"),
+    "air.added_std": (0.0, 1.0, "", "a relative standard deviation: 0 .. 100 %"),
 }
+# The air's ellipsoid: each semi-axis between these fractions of the rig's size, its centre at most
+# MAX_COM_OFFSET x the size from the COM (it is the body's own outline).
+AIR_SIZE = (1e-4, 10.0)
 MAX_WIRES = 64  # a rig is a body on a few wires; a 100,000-wire file is a mistake (it crashed MuJoCo)
 MIN_ATTACH_SPAN = 1e-3  # x S: closer attachments hang the body from one point (a 1e-8 m pair is singular)
 MAX_COM_OFFSET = 10.0  # x S: the COM's distance from the nearest attachment
@@ -86,6 +93,24 @@ def check_ranges(rig, free_moment: int | None = None) -> None:
     within(float(np.linalg.norm(rig.initial_omega)), 0.0, MAX_OMEGA * rate, src, "initial.omega", "rad/s",
            f"|omega| at most {MAX_OMEGA:g} x sqrt(g / shortest wire) = {MAX_OMEGA * rate:.3g} rad/s")
     _check_sigmas(rig, size)
+    if rig.air is not None:
+        _check_air(rig, size)
+
+
+def _check_air(rig, size: float) -> None:
+    air, src = rig.air, rig.source
+    for name, value in (("density", air.density), ("viscosity", air.viscosity), ("added_std", air.added_std)):
+        low, high, unit, why = RANGES[f"air.{name}"]
+        within(float(value), low, high, src, f"air.{name}", unit, why)
+    low, high, unit, why = RANGES["air.drag"]
+    for k, c in enumerate(air.drag):
+        within(float(c), low, high, src, f"air.drag[{k}]", unit, why)
+    full = 1.0 if air.shape == "ellipsoid" else 2.0  # a box is written by its full edges
+    for k, r in enumerate(air.semi_axes):
+        within(float(r) * full, AIR_SIZE[0] * size, AIR_SIZE[1] * size, src, f"air.size[{k}]", "m",
+               f"{AIR_SIZE[0]:g} .. {AIR_SIZE[1]:g} x the rig's size {size:.3g} m")
+    within(float(np.linalg.norm(air.center - rig.com)), 0.0, MAX_COM_OFFSET * size, src, "air.center", "m",
+           f"its distance from the COM, at most {MAX_COM_OFFSET:g} x the rig's size {size:.3g} m")
 
 
 def _check_sigmas(rig, size: float) -> None:
