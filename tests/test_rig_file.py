@@ -211,3 +211,22 @@ def test_every_pair_of_wires_must_close_its_loop(tmp_path, capsys):
     assert main(["modes", str(path)]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "no taut pose" in err and "wires 1 and 3" in err, err
+
+
+@pytest.mark.parametrize("line, field", [
+    ("density = 1e30", "air.density"),  # had given periods of 1e15 s
+    ("density = 1e-30", "air.density"),
+    ("viscosity = 1e9", "air.viscosity"),
+    ("size = [1e9, 0.02, 0.18]", "air.size[0]"),
+    ("size = [1e-9, 0.02, 0.18]", "air.size[0]"),
+    ("added_std = 2.0", "air.added_std"),
+])
+def test_air_fields_have_physical_ranges(tmp_path, capsys, line, field):
+    key = line.split(" =")[0]
+    text = "\n".join(line if row.startswith(f"{key} =") else row
+                     for row in (RIGS / "foam_wing.toml").read_text().splitlines())
+    path = tmp_path / "wing.toml"
+    path.write_text(text + "\n")
+    assert main(["modes", str(path)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and f"{path}: {field}: " in err, err
