@@ -44,7 +44,7 @@ from scipy.linalg import eigh
 from scipy.spatial.transform import Rotation
 
 from bifilar.motion.kane import KaneModel
-from bifilar.motion.modes import NEUTRAL_RTOL, Modes, linearize
+from bifilar.motion.modes import DEGENERATE_RTOL, NEUTRAL_RTOL, Modes, linearize
 from bifilar.identification.periods import period as crossing_period
 from bifilar.rig import Rig, RigError
 from bifilar.motion.nwire import NWireModel
@@ -113,10 +113,28 @@ class Pencil:
 
     def modes(self, value: float):
         """(w2, v) of the oscillating modes at moment ``value``, longest period first: v M-normalised,
-        neutral modes dropped."""
+        neutral modes dropped. Within a set of equal frequencies (a yaw that happens to have a sway's
+        period) the basis is the one that degenerate perturbation theory picks for a change of J:
+        dM = dJ w w^T splits the set along the eigenvectors of (V^T w)(V^T w)^T, so one vector carries
+        all of the set's share about the axis and the others none (eigh's own basis would mix them,
+        and the association and the sensitivity with them)."""
         w2, v = eigh(self.lin.stiffness, self.mass(value))
         keep = w2 > NEUTRAL_RTOL * max(abs(w2).max(), 1e-300)
-        return w2[keep], v[:, keep]
+        w2, v = w2[keep], v[:, keep]
+        scale = max(abs(w2).max(), 1e-300) if len(w2) else 1.0
+        k = 0
+        while k < len(w2):
+            j = k + 1
+            while j < len(w2) and w2[j] - w2[k] <= DEGENERATE_RTOL * scale:
+                j += 1
+            c = self.w @ v[:, k:j]
+            if j - k > 1 and c @ c > 0.0:
+                # an orthogonal transform of the set whose first column is c / |c| (Householder)
+                basis = np.linalg.qr(np.column_stack([c, np.eye(j - k)[:, 1:]]))[0]
+                v = v.copy()
+                v[:, k:j] = v[:, k:j] @ basis
+            k = j
+        return w2, v
 
     def shares(self, value: float, v: np.ndarray) -> np.ndarray:
         """Kinetic share of the moment about the axis in each mode (columns of v, M-normalised)."""
