@@ -1,6 +1,6 @@
 """The compiled continuation of a sweep (bifilar/sweep/kernel.py with the compiled period slopes)
-against the general path (rest pose search, linearize, pencils, a fresh rest pose and eigen-solution
-per perturbed input) on every configuration of a bench-plate sweep's first 40 configurations and a
+against the general path from a global rest-pose search (SLSQP, linearize, pencils) on every
+configuration of a bench-plate sweep's first 40 configurations and a
 sweep of the asymmetric trifilar platform (made here, with a stated uncertainty).
 
 Tolerances: periods and static tensions come from the same equations solved to machine precision by
@@ -34,7 +34,7 @@ def _pairs(space, count, monkeypatch):
         fast = E.evaluate(space, values, guess)
         rig = E.configure(space.rig, values)
         general = E.Row(values=values)
-        E._general(space, rig, general, guess)
+        E._general(space, rig, general, None)  # the global search: no continuation at all
         E._limits(space, rig, general)
         out.append((fast, general))
         guess = fast.rest or guess
@@ -51,7 +51,7 @@ axes = ["x", "y", "z"]
 """
 
 
-@pytest.mark.parametrize("name", ["bench_plate.toml", "trifilar"])
+@pytest.mark.parametrize("name", ["bench_plate.toml", "trifilar", "parallel.toml"])
 def test_continued_rows_equal_general_path(name, monkeypatch, tmp_path):
     if name == "trifilar":
         rig = (MODELS / "rigs" / "trifilar_asymmetric.toml").read_text()
@@ -76,8 +76,11 @@ def test_continued_rows_equal_general_path(name, monkeypatch, tmp_path):
                 assert fast.dominant[axis] == general.dominant[axis]
         assert math.isnan(general.separation) or fast.separation == pytest.approx(general.separation, rel=1e-9)
     # the comparison is of the continued path, not of the general one twice: every configuration
-    # after the first that has a rest pose (unreachable ones have none) was continued
-    assert continued == sum(f.rest is not None for f, _ in pairs[1:]) and continued >= 5
+    # after the first that has a rest pose (unreachable ones have none) was continued, except on the
+    # parallel rig, whose rows are neutral (its COM on the attachment line) and go the general way
+    # from the neighbour's pose, which must not matter either (a yaw there shares a sway's period)
+    expected = 0 if name == "parallel.toml" else sum(f.rest is not None for f, _ in pairs[1:])
+    assert continued == expected and (continued >= 5 or name == "parallel.toml")
 
 
 def test_continuation_hands_back_a_neutral_rig():
