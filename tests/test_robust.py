@@ -100,6 +100,7 @@ def test_the_ranges_are_documented():
         assert f"`{field}`" in doc and f"{low:g}" in doc and f"{high:g}" in doc, field
     for name in ("MIN_ATTACH_SPAN", "MAX_COM_OFFSET", "MIN_INERTIA", "MAX_INERTIA", "MAX_OMEGA"):
         assert f"{getattr(ranges, name):g}" in doc, name
+    assert all(f"{x:g}" in doc for x in ranges.AIR_SIZE)
 
 
 def test_a_hundred_thousand_wires_are_refused_before_any_physics(tmp_path, capsys):
