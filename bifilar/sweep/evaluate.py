@@ -3,7 +3,10 @@
 Everything goes through the project's one code path: the rest pose of :mod:`bifilar.rig.statics`
 (continued from the neighbouring configuration's), the modes of :mod:`bifilar.motion.modes`, the mode
 associated with each measured axis and the linear propagation of the rig's ``[uncertainty]`` through
-the exact inversion that ``identify`` uses (:func:`bifilar.identification.propagation.linear`).
+the exact inversion that ``identify`` uses (:func:`bifilar.identification.propagation.linear`, its
+period slopes compiled). Where the neighbour's rest pose continues cleanly, the rest pose and the modes
+come from one compiled call instead (:mod:`bifilar.sweep.kernel`: the same Newton and the same reduced
+M and K), which tests/test_sweep_continued.py holds to this path row by row.
 
 Peak tension in a measured motion of amplitude A (the peak rotation about the axis, rad). The wire
 tensions of a state follow exactly from Newton-Euler with the wires as constraints (pose coordinates
@@ -148,7 +151,7 @@ def evaluate(space: Space, values: dict[str, float], guess: Rest | None = None) 
 
 
 def _continued(space: Space, rig: Rig, row: Row, guess: Rest) -> bool:
-    """Fill ``row`` from the compiled continuation; False (row untouched) if it hands back."""
+    """Fill ``row`` from the compiled continuation; False, with ``row`` untouched, if it hands back."""
     status, com, rot, tensions, w2, shapes = SK.continued_modes(
         arms(rig), anchors(rig), lengths(rig), rig.mass, rig.gravity, rig.inertia, rig_scale(rig), guess.com,
         guess.rotation, guess.tensions, NULL_RTOL, NEUTRAL_RTOL, DEGENERATE_RTOL, NEUTRAL_SLACK)
@@ -156,19 +159,13 @@ def _continued(space: Space, rig: Rig, row: Row, guess: Rest) -> bool:
         return False
     rest = Rest(com, rot, tensions)
     periods = 2.0 * np.pi / np.sqrt(w2)  # w2 ascending: the longest period first
-    row.rest = rest
-    row.tensions = tuple(float(t) for t in tensions[:2])
-    row.periods = tuple(([float(p) for p in periods] + [None] * 4)[:4])
-    row.motions = tuple(([motion_of(rig, rest, shapes[:3, k], shapes[3:, k]) for k in range(len(w2))] + [""] * 4)[:4])
-    row.separation = float(np.min((periods[:-1] - periods[1:]) / periods[:-1])) if len(w2) > 1 else math.nan
-    row.sigma, row.dominant, row.budget = {}, {}, {}
-    bases, chosen = {}, {}
+    bases, chosen, unmeasurable = {}, {}, []
     for axis in space.measure:
         about = rot @ ident.axis_vector(axis)
         j0 = ident.moment(rig, axis)
         shares = j0 * (about @ shapes[3:]) ** 2  # the pencil's shares: the shapes are M-normalised
         if shares.max() < 1e-12:  # no mode turns about the axis
-            row.sigma[axis], row.dominant[axis] = None, None
+            unmeasurable.append(axis)
             continue
         k = int(np.argmax(shares))
         chosen[axis] = k
@@ -178,6 +175,12 @@ def _continued(space: Space, rig: Rig, row: Row, guess: Rest) -> bool:
                               np.array([rig.inertia] * len(chosen)).reshape(-1, 3, 3))
     if not ok:
         return False
+    row.rest = rest
+    row.tensions = tuple(float(t) for t in tensions[:2])
+    row.periods = tuple(([float(p) for p in periods] + [None] * 4)[:4])
+    row.motions = tuple(([motion_of(rig, rest, shapes[:3, k], shapes[3:, k]) for k in range(len(w2))] + [""] * 4)[:4])
+    row.separation = float(np.min((periods[:-1] - periods[1:]) / periods[:-1])) if len(w2) > 1 else math.nan
+    row.sigma, row.dominant, row.budget = {a: None for a in unmeasurable}, {a: None for a in unmeasurable}, {}
     for n, (axis, k) in enumerate(chosen.items()):
         values = inp.values.copy()
         values[-1] = bases[axis].period  # the measured period: the one input that differs between axes
