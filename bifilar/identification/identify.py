@@ -44,7 +44,7 @@ from scipy.linalg import eigh
 from scipy.spatial.transform import Rotation
 
 from bifilar.motion.kane import KaneModel
-from bifilar.motion.modes import DEGENERATE_RTOL, NEUTRAL_RTOL, Modes, linearize
+from bifilar.motion.modes import NEUTRAL_RTOL, Modes, degenerate_sets, linearize
 from bifilar.identification.periods import period as crossing_period
 from bifilar.rig import Rig, RigError
 from bifilar.motion.nwire import NWireModel
@@ -121,19 +121,11 @@ class Pencil:
         w2, v = eigh(self.lin.stiffness, self.mass(value))
         keep = w2 > NEUTRAL_RTOL * max(abs(w2).max(), 1e-300)
         w2, v = w2[keep], v[:, keep]
-        scale = max(abs(w2).max(), 1e-300) if len(w2) else 1.0
-        k = 0
-        while k < len(w2):
-            j = k + 1
-            while j < len(w2) and w2[j] - w2[k] <= DEGENERATE_RTOL * scale:
-                j += 1
+        for k, j in degenerate_sets(w2):
             c = self.w @ v[:, k:j]
-            if j - k > 1 and c @ c > 0.0:
+            if c @ c > 0.0:
                 # an orthogonal transform of the set whose first column is c / |c| (Householder)
-                basis = np.linalg.qr(np.column_stack([c, np.eye(j - k)[:, 1:]]))[0]
-                v = v.copy()
-                v[:, k:j] = v[:, k:j] @ basis
-            k = j
+                v[:, k:j] = v[:, k:j] @ np.linalg.qr(np.column_stack([c, np.eye(j - k)[:, 1:]]))[0]
         return w2, v
 
     def shares(self, value: float, v: np.ndarray) -> np.ndarray:
@@ -224,14 +216,13 @@ def invert_period(rig: Rig, axis, period: float, rest: Rest | None = None, p: Pe
         if hit is not None and p.associated(hit[0])[0] == hit[1]:
             found[round(hit[0], 9 - int(np.floor(np.log10(hit[0]))))] = hit
     if not found:
-        k0 = int(np.argmax(p.shares(p.moment0, v)))
         ends = [p.associated(j) for j in (p.floor + np.exp(np.log(p.moment0 - p.floor) - _REACH),
                                           p.floor + np.exp(np.log(p.moment0 - p.floor) + _REACH))]
         low, high = sorted(2.0 * np.pi / np.sqrt(w2_[k_]) for k_, w2_, _ in ends)
         raise RigError(src, "period", f"{period:.9g} s: no moment about {name} within a factor 1e6 of the "
                                       f"rig's {p.moment0:.6g} kg m^2 gives the mode turning about it this period "
                                       f"(it spans {low:.9g}..{high:.9g} s there; d ln T / d ln J = "
-                                      f"{0.5 * p.shares(p.moment0, v)[k0]:.2g} at the rig's moment)")
+                                      f"{predicted(rig, p).sensitivity:.2g} at the rig's moment)")
     if len(found) > 1:
         raise RigError(src, "period", f"{period:.9g} s is ambiguous: moments {', '.join(f'{j:.6g}' for j in found)} "
                                       f"kg m^2 about {name} all give it")
@@ -251,9 +242,7 @@ def predicted(rig: Rig, p: Pencil) -> Identified:
 
 def linear_period(rig: Rig, axis, rest: Rest | None = None) -> float:
     """Small-amplitude period (s) of the mode associated with ``axis`` at the rig's own inertia."""
-    p = pencil(rig, axis, rest)
-    k, w2, _ = p.associated(p.moment0)
-    return float(2.0 * np.pi / np.sqrt(w2[k]))
+    return predicted(rig, pencil(rig, axis, rest)).period
 
 
 @dataclass(frozen=True)

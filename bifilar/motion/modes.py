@@ -108,30 +108,38 @@ def motion_of(rig: Rig, rest: Rest, com: np.ndarray, rotation: np.ndarray) -> st
     return max(MOTIONS, key=energy.__getitem__)
 
 
-def _resolve_degenerate(w2: np.ndarray, vecs: np.ndarray, z: np.ndarray, m6: np.ndarray) -> np.ndarray:
-    """Eigenvectors with every degenerate eigenspace spanned along :data:`_PREFERRED` directions
-    (M-orthonormal, by Gram-Schmidt), each with its largest pose component positive."""
-    vecs = vecs.copy()
-    scale = max(abs(w2).max(), 1e-300)
-    k = 0
+def degenerate_sets(w2: np.ndarray) -> list[tuple[int, int]]:
+    """(start, stop) of each run of two or more ascending eigenvalues ``w2`` that are one frequency:
+    within :data:`DEGENERATE_RTOL` of the largest |w2| of each other."""
+    scale = max(abs(w2).max(), 1e-300) if len(w2) else 1.0
+    sets, k = [], 0
     while k < len(w2):
         j = k + 1
         while j < len(w2) and w2[j] - w2[k] <= DEGENERATE_RTOL * scale:
             j += 1
         if j - k > 1:
-            space = vecs[:, k:j]
-            chosen = []
-            for direction in _PREFERRED:
-                v = space @ (space.T @ (z.T @ m6 @ direction))  # M-projection onto the eigenspace
-                for c in chosen:
-                    v = v - c * (c @ (z.T @ m6 @ z) @ v)
-                norm = np.sqrt(v @ (z.T @ m6 @ z) @ v)
-                if norm > 1e-6 * np.sqrt(np.abs(m6).max()):
-                    chosen.append(v / norm)
-                if len(chosen) == j - k:
-                    break
-            vecs[:, k:j] = np.array(chosen).T
+            sets.append((k, j))
         k = j
+    return sets
+
+
+def _resolve_degenerate(w2: np.ndarray, vecs: np.ndarray, z: np.ndarray, m6: np.ndarray) -> np.ndarray:
+    """Eigenvectors with every degenerate eigenspace spanned along :data:`_PREFERRED` directions
+    (M-orthonormal, by Gram-Schmidt), each with its largest pose component positive."""
+    vecs = vecs.copy()
+    for k, j in degenerate_sets(w2):
+        space = vecs[:, k:j]
+        chosen = []
+        for direction in _PREFERRED:
+            v = space @ (space.T @ (z.T @ m6 @ direction))  # M-projection onto the eigenspace
+            for c in chosen:
+                v = v - c * (c @ (z.T @ m6 @ z) @ v)
+            norm = np.sqrt(v @ (z.T @ m6 @ z) @ v)
+            if norm > 1e-6 * np.sqrt(np.abs(m6).max()):
+                chosen.append(v / norm)
+            if len(chosen) == j - k:
+                break
+        vecs[:, k:j] = np.array(chosen).T
     for col in range(vecs.shape[1]):
         shape = z @ vecs[:, col]
         if shape[np.argmax(np.abs(shape))] < 0.0:
