@@ -31,8 +31,8 @@ from bifilar.rig import pose_kernel as PK
 # Newton on the equilibrium equations converges quadratically: 30 iterations is ample from any start
 # SLSQP hands it; a residual of 1e-12 (forces / weight, lengths / rig size) is machine precision on
 # ordinary rigs and ~1e-13 of the weight where a Jacobian is nearly singular.
-_NEWTON_ITERATIONS = 30
-_RESIDUAL = 1e-12
+NEWTON_ITERATIONS = 30
+RESIDUAL = 1e-12
 # Constraint rows whose singular value is below this fraction of the largest are dependent.
 NULL_RTOL = 1e-9
 # A body frame turned more than this (rad) from the way the body hangs gets a second SLSQP start: from
@@ -138,11 +138,11 @@ def _polish(rig: Rig, com: np.ndarray, rotation: np.ndarray, tensions: np.ndarra
     try:
         com, rotation, tensions, residual, _ = PK.newton_equilibrium(
             np.asarray(com, float), np.asarray(rotation, float), np.asarray(tensions, float),
-            arms(rig), anchors(rig), lengths(rig), weight, rig_scale(rig), _NEWTON_ITERATIONS,
+            arms(rig), anchors(rig), lengths(rig), weight, rig_scale(rig), NEWTON_ITERATIONS,
         )
     except np.linalg.LinAlgError:  # a singular Jacobian: a neutral direction (see _global_rest_pose)
         return None
-    if not residual <= _RESIDUAL:
+    if not residual <= RESIDUAL:
         return None
     return Rest(com=com, rotation=rotation, tensions=tensions)
 

@@ -22,10 +22,9 @@ import numpy as np
 
 from bifilar.motion import nwire_kernel as NK
 from bifilar.rig import pose_kernel as PK
+from bifilar.rig.statics import NEWTON_ITERATIONS, RESIDUAL  # the same Newton as rest_pose
 
 OK, NO_NEWTON, SLACK, NO_MODES, UNSTABLE, NEUTRAL, DEGENERATE = range(7)
-_NEWTON_ITERATIONS = 30  # as bifilar.rig.statics
-_RESIDUAL = 1e-12
 
 
 @nb.njit(cache=True)
@@ -37,8 +36,8 @@ def continued_modes(arms, anchors, lengths, mass, gravity, inertia, scale, com, 
     empty = np.zeros(0)
     weight = mass * gravity
     com, rot, tensions, residual, _ = PK.newton_equilibrium(com, rot, tensions, arms, anchors, lengths, weight,
-                                                            scale, _NEWTON_ITERATIONS)
-    if not residual <= _RESIDUAL:
+                                                            scale, NEWTON_ITERATIONS)
+    if not residual <= RESIDUAL:
         return NO_NEWTON, com, rot, tensions, empty, np.zeros((6, 0))
     if tensions.min() <= 0.0:
         return SLACK, com, rot, tensions, empty, np.zeros((6, 0))
