@@ -118,24 +118,25 @@ def constraint_hessian(s, u, rho, i):
 @nb.njit(cache=True)
 def equilibrium_balance(com, rot, tensions, arms, anchors, lengths, weight, scale):
     """The residual of :func:`equilibrium_residual` alone (6 + N), without its Jacobian."""
-    n = arms.shape[0]
+    s, u, rho = wire_geometry(com, rot, arms, anchors)
+    return _balance(s, u, rho, tensions, lengths, weight, scale)
+
+
+@nb.njit(cache=True)
+def _balance(s, u, rho, tensions, lengths, weight, scale):
+    """Force balance / W, moment balance / (W scale) and length errors / scale from the wire geometry."""
+    n = s.shape[0]
     res = np.zeros(6 + n)
     res[2] = -1.0
     for i in range(n):
         t = tensions[i] / weight
-        s0 = rot[0, 0] * arms[i, 0] + rot[0, 1] * arms[i, 1] + rot[0, 2] * arms[i, 2]
-        s1 = rot[1, 0] * arms[i, 0] + rot[1, 1] * arms[i, 1] + rot[1, 2] * arms[i, 2]
-        s2 = rot[2, 0] * arms[i, 0] + rot[2, 1] * arms[i, 1] + rot[2, 2] * arms[i, 2]
-        d0, d1, d2 = anchors[i, 0] - com[0] - s0, anchors[i, 1] - com[1] - s1, anchors[i, 2] - com[2] - s2
-        rho = np.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
-        u0, u1, u2 = d0 / rho, d1 / rho, d2 / rho
-        res[0] += t * u0
-        res[1] += t * u1
-        res[2] += t * u2
-        res[3] += t * (s1 * u2 - s2 * u1) / scale
-        res[4] += t * (s2 * u0 - s0 * u2) / scale
-        res[5] += t * (s0 * u1 - s1 * u0) / scale
-        res[6 + i] = (rho - lengths[i]) / scale
+        res[0] += t * u[i, 0]
+        res[1] += t * u[i, 1]
+        res[2] += t * u[i, 2]
+        res[3] += t * (s[i, 1] * u[i, 2] - s[i, 2] * u[i, 1]) / scale
+        res[4] += t * (s[i, 2] * u[i, 0] - s[i, 0] * u[i, 2]) / scale
+        res[5] += t * (s[i, 0] * u[i, 1] - s[i, 1] * u[i, 0]) / scale
+        res[6 + i] = (rho[i] - lengths[i]) / scale
     return res
 
 
@@ -145,7 +146,7 @@ def equilibrium_residual(com, rot, tensions, arms, anchors, lengths, weight, sca
     (6 + N), and its Jacobian with respect to (x, theta, t / W)."""
     n = arms.shape[0]
     s, u, rho = wire_geometry(com, rot, arms, anchors)
-    res = equilibrium_balance(com, rot, tensions, arms, anchors, lengths, weight, scale)
+    res = _balance(s, u, rho, tensions, lengths, weight, scale)
     jac = np.zeros((6 + n, 6 + n))
     for i in range(n):
         t = tensions[i] / weight
