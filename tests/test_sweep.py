@@ -301,3 +301,17 @@ def test_resume_digest_follows_every_file_the_sweep_reads(tmp_path):
     parts.write_text(parts.read_text().replace("mass = 15.0", "mass = 15.5", 1))
     assert digest(str(folder / "configurations.toml"), 64) != before
     assert digest(str(folder / "configurations.toml"), 64) == digest(str(folder / "configurations.toml"), 64)
+
+
+def test_a_chunk_of_points_is_that_slice_of_the_grid():
+    """points(start, stop), reached from the index (C order, the last axis fastest), is the slice of
+    the whole grid in grid order; for explicit points, of the file's list."""
+    from validate.assets import MODELS
+
+    for name in ("sweeps/bench_plate.toml", "solar_boat/configurations.toml"):
+        space = load_space(MODELS / name)
+        every = list(space.points())
+        assert len(every) == space.size
+        assert list(space.points(1, space.size - 1)) == every[1:-1]
+    grid = list(load_space(MODELS / "sweeps" / "bench_plate.toml").points(0, 2))
+    assert grid[0]["attach_span"] != grid[1]["attach_span"] and grid[0]["wire_length"] == grid[1]["wire_length"]

@@ -64,11 +64,7 @@ def _evaluate_range(path: str, start: int, stop: int) -> list[dict]:
     space = load_space(path)
     guess: Rest | None = None
     rows = []
-    for index, values in enumerate(space.points()):
-        if index < start:
-            continue
-        if index >= stop:
-            break
+    for values in space.points(start, stop):
         row = evaluate(space, values, guess)
         guess = row.rest if row.rest is not None else guess
         rows.append(_plain(row))

@@ -32,7 +32,6 @@ floor, and the clearance is that of the lowest point of the body's parts, not of
 
 from __future__ import annotations
 
-import itertools
 import math
 from dataclasses import dataclass
 from pathlib import Path
@@ -80,12 +79,15 @@ class Space:
             return len(next(iter(self.axes.values())))
         return int(np.prod([len(v) for v in self.axes.values()]))
 
-    def points(self):
-        """Every configuration as a dict axis -> value, in grid (or file) order."""
-        names = list(self.axes)
-        combos = zip(*self.axes.values()) if self.explicit else itertools.product(*self.axes.values())
-        for combo in combos:
-            yield dict(zip(names, (float(v) for v in combo)))
+    def points(self, start: int = 0, stop: int | None = None):
+        """Configurations ``start`` .. ``stop - 1`` (default every one) as dicts axis -> value, in grid
+        (or file) order: the last axis fastest. Each is reached from its index (C order), so a chunk
+        deep in a large grid costs no walk through the configurations before it."""
+        names, values = list(self.axes), list(self.axes.values())
+        shape = [len(v) for v in values]
+        for index in range(start, self.size if stop is None else min(stop, self.size)):
+            at = [index] * len(values) if self.explicit else np.unravel_index(index, shape)
+            yield {name: float(v[k]) for name, v, k in zip(names, values, at)}
 
 
 def _values(raw, src: str, name: str) -> np.ndarray:
