@@ -114,7 +114,8 @@ class Propagation:
     gradient: np.ndarray
 
 
-def _budget(inp: Inputs, gradient: np.ndarray) -> dict[str, float]:
+def budget(inp: Inputs, gradient: np.ndarray) -> dict[str, float]:
+    """Each :data:`GROUPS` entry's share of the variance sum_i (gradient_i std_i)^2 (0 where it is 0)."""
     parts = (gradient * inp.std) ** 2
     total = parts.sum()
     shares = np.zeros(len(GROUPS))
@@ -165,7 +166,7 @@ def propagate(base: Identified, slopes: np.ndarray, own: Inputs) -> Propagation:
     gradient = np.where(own.std > 0.0, gradient, 0.0)
     std = float(np.sqrt(np.sum((gradient * own.std) ** 2)))
     return Propagation(base.moment, std, base.moment - _Z * std, base.moment + _Z * std, "linear",
-                       _budget(own, gradient), own, gradient)
+                       budget(own, gradient), own, gradient)
 
 
 def kernel_slopes(rig: Rig, rest: Rest, inp: Inputs, shapes: np.ndarray, inertias: np.ndarray):
@@ -216,7 +217,7 @@ def monte_carlo(rig: Rig, axis, period: float, period_std: float, samples: int, 
     gradient[varied] = slopes / inp.std[varied]
     low, high = np.quantile(draws, [0.5 - LEVEL / 2.0, 0.5 + LEVEL / 2.0])
     return Propagation(base.moment, float(draws.std(ddof=1)), float(low), float(high), f"monte-carlo ({samples})",
-                       _budget(inp, gradient), inp, gradient)
+                       budget(inp, gradient), inp, gradient)
 
 
 @dataclass(frozen=True)

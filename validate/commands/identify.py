@@ -151,10 +151,10 @@ def _identify(path: str, args, period, signals, amplitude="args"):
     rig = vacuum(rig_in_air)  # the moment identified is the apparent one, the air's included
     flags = []
     trials = []
-    p = pencil(rig, axis)
+    p = pencil(rig, axis)  # the rig's one rest-pose search: everything below is about this rest pose
     if signals is None:
         try:
-            found = identify(rig, axis, period, amplitude or 0.0)
+            found = identify(rig, axis, period, amplitude or 0.0, p.lin.rest)
         except RigError as exc:
             if exc.field == "period":
                 option = "--period" if path == args.rig else "--tare-period"
@@ -176,7 +176,7 @@ def _identify(path: str, args, period, signals, amplitude="args"):
         if not pooled.consistent:
             flags.append(f"the {len(trials)} trials scatter more than their stated sigmas (chi^2 per degree of "
                          f"freedom {pooled.chi2_per_dof:.3g}): the pooled sigma is scaled by its square root")
-    report = _propagate(rig, axis, small, small_std, args.samples, flags)
+    report = _propagate(rig, axis, small, small_std, args.samples, flags, p)
     report["period_std_source"] = period_std_source
     report["start_value"] = "nan in the rig file" if was_nan else "the rig file's value (a start only)"
     if pooled is None:
@@ -203,17 +203,18 @@ def _identify(path: str, args, period, signals, amplitude="args"):
     return report, trials
 
 
-def _propagate(rig, axis: str, period: float, period_std: float, samples, flags: list) -> dict:
-    """The propagated moment and everything derived from it (per mass, checks, flags)."""
-    from bifilar.identification.identify import invert_period, pencil, with_moment
-    from bifilar.identification.propagation import linear, monte_carlo
+def _propagate(rig, axis: str, period: float, period_std: float, samples, flags: list, p) -> dict:
+    """The propagated moment and everything derived from it (per mass, checks, flags); ``p`` is the
+    rig's pencil about ``axis`` (its rest pose and linearisation)."""
+    from bifilar.identification.identify import invert_period, with_moment
+    from bifilar.identification.propagation import budget, linear_axes, monte_carlo
 
-    found = invert_period(rig, axis, period)
+    found = invert_period(rig, axis, period, p.lin.rest, p)
     geometry = [g for g in ("length", "anchor", "attach", "mass", "com") if getattr(rig.uncertainty, g) > 0.0]
     if samples and (geometry or period_std > 0.0):
         result = monte_carlo(rig, axis, period, period_std, samples, np.random.default_rng(0))
     else:
-        result = linear(rig, axis, period, period_std)
+        result = linear_axes(rig, {axis: period}, period_std, p.lin.rest, {axis: found}, p.lin)[axis]
     j, m = result.moment, found.rig.mass
     inp = result.inputs
     parts = (result.gradient * inp.std) ** 2
@@ -222,13 +223,12 @@ def _propagate(rig, axis: str, period: float, period_std: float, samples, flags:
     # J / m: the same inputs; the mass enters as d(J/m)/dm = (dJ/dm)/m - J/m^2
     per_mass_gradient = result.gradient / m
     per_mass_gradient[groups == "mass"] -= j / m**2
-    per_parts = (per_mass_gradient * inp.std) ** 2
-    std_pm = float(np.sqrt(per_parts.sum()))
+    std_pm = float(np.sqrt(np.sum((per_mass_gradient * inp.std) ** 2)))
     propagated = bool(np.any(inp.std > 0.0))
     if not geometry:
         flags.append("the rig file has no [uncertainty] for geometry or mass: nothing of the rig was propagated"
                      + ("" if period_std > 0.0 else ", nor of the period: no uncertainty is stated"))
-    floor = pencil(rig, axis).floor
+    floor = p.floor
     if propagated and result.low <= max(floor, 0.0):
         flags.append(f"the 95 % interval reaches {result.low:.6g} kg m^2, a moment no body has (the tensor is "
                      f"positive definite only above {max(floor, 0.0):.6g}): this rig cannot determine it")
@@ -258,15 +258,10 @@ def _propagate(rig, axis: str, period: float, period_std: float, samples, flags:
         "radius_of_gyration_std": std_pm / (2.0 * k) if propagated and k else None,
         "method": result.method,
         "budget": result.budget if propagated else None,
-        "budget_per_mass": _shares(groups, per_parts) if propagated else None,
+        "budget_per_mass": budget(inp, per_mass_gradient) if propagated else None,
         "tensor_check": check,
         "flags": flags,
     }
-
-
-def _shares(groups: np.ndarray, parts: np.ndarray) -> dict:
-    total = parts.sum()
-    return {g: float(parts[groups == g].sum() / total) if total > 0 else 0.0 for g in dict.fromkeys(groups)}
 
 
 def _tensor_check(inertia: np.ndarray) -> dict:
