@@ -25,6 +25,7 @@ from bifilar.identification.records import Record
 from bifilar.identification.signals import EXCESS_PRIOR, AmplitudeLaw, OscillationFit, fit_record
 from bifilar.motion import lagrange
 from bifilar.rig import Rig, RigError
+from bifilar.rig.statics import Rest
 
 CONSISTENCY = 0.99  # chi^2 quantile above which the trials are called inconsistent
 _LAW_RTOL = 1e-3  # a series law this close to the one fitted with does not change the fit
@@ -32,20 +33,21 @@ _LAW_RTOL = 1e-3  # a series law this close to the one fitted with does not chan
 _MATCH_FROM = 0.1
 
 
-def law_for(rig: Rig, axis, amplitude: float | None = None) -> AmplitudeLaw:
+def law_for(rig: Rig, axis, amplitude: float | None = None, rest: Rest | None = None) -> AmplitudeLaw:
     """The exact 1-DOF torsion law for the vertical axis of a symmetric rig, else the Kane model's
     period-amplitude series at the rig's moment (module docstring of :mod:`.signals`), right at
     O(A^2); with the record's largest ``amplitude`` (rad) its quintic is matched to the Kane model's
-    T(A) / T0 there (:meth:`AmplitudeLaw.matched`), so that the law holds over the record's range."""
+    T(A) / T0 there (:meth:`AmplitudeLaw.matched`), so that the law holds over the record's range.
+    ``rest``: the rig's rest pose if known (it does not depend on the inertia)."""
     if np.allclose(axis_vector(axis), AXES["z"]):
         try:
             return AmplitudeLaw.torsion(lagrange.from_rig(rig))
         except RigError:
             pass  # not a symmetric torsion: the Kane series below
-    law = AmplitudeLaw("series", s=amplitude_coefficient(rig, axis))
+    law = AmplitudeLaw("series", s=amplitude_coefficient(rig, axis, rest))
     if amplitude is not None and amplitude > _MATCH_FROM:
-        omega = 2.0 * math.pi / linear_period(rig, axis)
-        law = law.matched(amplitude, amplitude_ratio(rig, axis, amplitude), omega)
+        omega = 2.0 * math.pi / linear_period(rig, axis, rest)
+        law = law.matched(amplitude, amplitude_ratio(rig, axis, amplitude, rest), omega)
     return law
 
 
@@ -69,12 +71,12 @@ def fit_trial(rig: Rig, axis, record: Record, p: Pencil | None = None, excess_pr
     fit cannot use or a period no moment gives.
     """
     p = pencil(rig, axis) if p is None else p
-    law = law_for(rig, axis)
+    law = law_for(rig, axis, rest=p.lin.rest)
     try:
         fit = fit_record(record, law, excess_prior=excess_prior)
         found = invert_period(rig, axis, fit.period, p=p)
         if law.kind == "series":
-            better = law_for(found.rig, axis, fit.amplitude[0] if fit.amplitude else None)
+            better = law_for(found.rig, axis, fit.amplitude[0] if fit.amplitude else None, p.lin.rest)
             if abs(better.s - law.s) > _LAW_RTOL * abs(law.s) or better.quintic != law.quintic:
                 fit = fit_record(record, better, excess_prior=excess_prior)
                 found = invert_period(rig, axis, fit.period, p=p)
