@@ -66,6 +66,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--jobs", type=whole_number("--jobs", 1, 64), default=2,
                    help="cases run in parallel worker processes, 1-64 (default: 2)")
     p.add_argument("--rerun", metavar="DIR", help="also write one rerun recording per case, DIR/<case>.rrd (default: none)")
+    _report_options(p)
 
     sub.add_parser("list", help="list the registered cases with their whole descriptions")
 
@@ -74,6 +75,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--json", metavar="REPORT.json", help="also write the report as JSON (default: none)")
     p.add_argument("--rerun", metavar="FILE.rrd",
                    help="also write a rerun recording of the case, open with: rerun FILE.rrd (default: none)")
+    _report_options(p)
 
     p = sub.add_parser("modes", help="rest pose, static tensions and small-oscillation periods", epilog=EPILOG)
     p.add_argument("rig", help="rig file (TOML), e.g. models/rigs/plate.toml")
@@ -107,6 +109,13 @@ def build_parser() -> argparse.ArgumentParser:
     boat_cli.add_parser(sub)
     sweep_cli.add_parser(sub)
     return parser
+
+
+def _report_options(p) -> None:
+    p.add_argument("--junit", metavar="FILE.xml", help="also write the results as JUnit XML, for CI servers (default: none)")
+    p.add_argument("--html", metavar="FILE.html",
+                   help="also write one self-contained HTML page: summary, every case's metrics and figures "
+                        "(default: none)")
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -230,7 +239,7 @@ def _check_outputs(args) -> None:
     """Every output path is checked writable before the work starts (:func:`check_writable`)."""
     from .trajectory import check_writable
 
-    for name in ("out", "json", "rerun", "png"):
+    for name in ("out", "json", "rerun", "png", "junit", "html"):
         value = getattr(args, name, None)
         if not isinstance(value, str):
             continue
@@ -381,13 +390,30 @@ def _cmd_all(args) -> int:
 
     cases = select(registered(slow=args.slow or bool(args.tag)), args.pattern, args.tag)
     return run_cases(cases, jobs=args.jobs, json_path=args.json, on_result=_recorder(args.rerun, folder=True),
-                     progress=True)
+                     progress=True, reports=_reports(args, cases), traces=bool(args.html))
 
 
 def _cmd_case(args) -> int:
     from .suite import find, run_cases
 
-    return run_cases([find(args.name)], jobs=1, json_path=args.json, on_result=_recorder(args.rerun, folder=False))
+    cases = [find(args.name)]
+    return run_cases(cases, jobs=1, json_path=args.json, on_result=_recorder(args.rerun, folder=False),
+                     reports=_reports(args, cases), traces=bool(args.html))
+
+
+def _reports(args, cases) -> list:
+    """The writers of ``--junit`` and ``--html``, each called with the results and the wall time."""
+    out = []
+    if args.junit:
+        from .report.junit import write_junit
+
+        out.append(lambda results, seconds: write_junit(args.junit, results, seconds))
+    if args.html:
+        from .report.suite_page import write_suite_html
+
+        descriptions = {c.name: c.description for c in cases}
+        out.append(lambda results, seconds: write_suite_html(args.html, results, seconds, descriptions))
+    return out
 
 
 def _recorder(dest: str | None, folder: bool):

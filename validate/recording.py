@@ -32,6 +32,7 @@ from scipy.spatial.transform import Rotation
 
 from bifilar.bodies.composite import equivalent_box
 
+from .compare import by_rig, columns, compared, differences
 from .registry import Metric
 from .trajectory import RIG_CHANNELS, Trajectory, check_writable
 
@@ -83,7 +84,7 @@ def record(path: str | Path, title: str, trajectories: Sequence[Trajectory], met
     ``passed`` (None: no verdict), a free ``note`` (e.g. the error a case raised) and ``extra``.
     Returns the path."""
     runs = _runs(trajectories)
-    diffs = [(ref, run, differences(ref.traj, run.traj)) for ref, run in _compared(runs)]
+    diffs = [(ref, run, differences(ref.traj, run.traj)) for ref, run in compared(runs, _rig, _engine)]
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     check_writable(path)
@@ -147,11 +148,12 @@ def _runs(trajectories: Sequence[Trajectory]) -> list[_Run]:
     return runs
 
 
-def _by_rig(runs: list[_Run]) -> dict[str, list[_Run]]:
-    groups: dict[str, list[_Run]] = {}
-    for r in runs:
-        groups.setdefault(r.rig, []).append(r)
-    return groups
+def _rig(run: _Run) -> str:
+    return run.rig
+
+
+def _engine(run: _Run) -> str:
+    return run.traj.engine
 
 
 def _time(t: np.ndarray) -> list[rr.TimeColumn]:
@@ -183,7 +185,7 @@ def _log_scene(rec: rr.RecordingStream, runs: list[_Run]) -> None:
     rec.log("world", rr.ViewCoordinates.RIGHT_HAND_Z_UP, static=True)
     t_max = max(float(np.nanmax(r.traj["tension"], initial=0.0)) for r in runs) or 1.0
     x = last_reach = 0.0
-    for rig_name, group in _by_rig(runs).items():
+    for rig_name, group in by_rig(runs, _rig).items():
         rig = group[0].traj.meta["rig_spec"]
         reach = max(abs(w.anchor[0]) for w in rig.wires) + max(w.length for w in rig.wires)  # in x, from x = 0
         x += 1.1 * (last_reach + reach) if last_reach else 0.0
@@ -237,17 +239,6 @@ def _components(channel: str, k: int) -> list[str]:
     return [channel] if k == 1 else [f"{channel}[{i}]" for i in range(k)]
 
 
-def _columns(traj: Trajectory) -> dict[str, np.ndarray]:
-    """Every numeric channel as an (n, k) float array."""
-    n = len(traj.t)
-    out = {}
-    for name, values in traj.channels.items():
-        arr = np.asarray(values)
-        if arr.dtype.kind in "fiub" and arr.ndim in (1, 2) and len(arr) == n:
-            out[name] = arr.reshape(n, -1).astype(float, copy=False)
-    return out
-
-
 def _send_series(rec: rr.RecordingStream, entity: str, t: np.ndarray, values: np.ndarray, names: list[str]) -> None:
     rec.log(entity, rr.SeriesLines(names=names), static=True)
     rec.send_columns(entity, _time(t), rr.Scalars.columns(scalars=values))
@@ -256,40 +247,13 @@ def _send_series(rec: rr.RecordingStream, entity: str, t: np.ndarray, values: np
 def _log_series(rec: rr.RecordingStream, runs: list[_Run], diffs: list) -> None:
     """``plots/<channel>/<run>`` for every channel and ``diff/<channel>/<run>`` for every difference."""
     for run in runs:
-        for name, values in _columns(run.traj).items():
+        for name, values in columns(run.traj).items():
             names = [f"{run.label} {c}" for c in _components(name, values.shape[1])]
             _send_series(rec, f"plots/{name}/{run.label}", run.traj.t, values, names)
     for ref, run, channels in diffs:
         for name, (t, values) in channels.items():
             names = [f"{run.label} - {ref.label} {c}" for c in _components(name, values.shape[1])]
             _send_series(rec, f"diff/{name}/{run.label}", t, values, names)
-
-
-def _compared(runs: list[_Run]) -> list[tuple[_Run, _Run]]:
-    """(reference, other) pairs: the first run of each rig against that rig's runs by other engines."""
-    return [(g[0], r) for g in _by_rig(runs).values() for r in g[1:] if r.traj.engine != g[0].traj.engine]
-
-
-def differences(ref: Trajectory, other: Trajectory) -> dict[str, tuple[np.ndarray, np.ndarray]]:
-    """``other - ref`` for each channel both carry with the same width, on ``ref``'s times within the
-    overlap of the two runs (``other`` interpolated linearly: exact where the grids coincide). The
-    quaternion channel becomes ``attitude``, the rotation angle (rad) from ``ref``'s attitude to
-    ``other``'s, which does not depend on the quaternions' signs."""
-    keep = (ref.t >= other.t[0] - 1e-12) & (ref.t <= other.t[-1] + 1e-12)
-    t = ref.t[keep]
-    a, b = _columns(ref), _columns(other)
-    out = {}
-    for name in a.keys() & b.keys():
-        if a[name].shape[1] != b[name].shape[1]:
-            continue
-        theirs = np.column_stack([np.interp(t, other.t, col) for col in b[name].T])
-        if name == "quat":
-            angle = (Rotation.from_quat(a[name][keep], scalar_first=True).inv()
-                     * Rotation.from_quat(theirs, scalar_first=True)).magnitude()
-            out["attitude"] = (t, angle[:, None])
-        else:
-            out[name] = (t, theirs - a[name][keep])
-    return dict(sorted(out.items()))
 
 
 # ---------------------------------------------------------------------------------------- summary, layout
@@ -324,7 +288,7 @@ def _plot(origin: str, channel: str, what: str) -> rrb.TimeSeriesView:
 def _blueprint(runs: list[_Run], diffs: list, extra_views: tuple = ()) -> rrb.Blueprint:
     """3D scene on the left; tensions, thesis angles and differences on the right, the other
     channels in tabs behind the metrics; ``extra_views`` in tabs before all that."""
-    channels = list(dict.fromkeys(c for r in runs for c in _columns(r.traj)))
+    channels = list(dict.fromkeys(c for r in runs for c in columns(r.traj)))
     main = [c for c in MAIN_PLOTS if c in channels]
     rest = [c for c in channels if c not in main]
     if not main:  # no rig channels: the system's own channels are what matters
