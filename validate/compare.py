@@ -1,5 +1,5 @@
-"""Runs of one system by different engines, paired and differenced: what a recording plots and the
-HTML report draws.
+"""Runs of one system by different engines, paired and differenced, and the signal that describes
+each run's motion with its period cycle by cycle: what a recording plots and the HTML report draws.
 
 A case hands its runs to ``ctx.keep`` (:class:`validate.registry.CaseContext`); runs are grouped by
 the rig they swing (``meta["rig"]``, ``"system"`` without one), and the first run of each group is the
@@ -13,6 +13,8 @@ from typing import TypeVar
 
 import numpy as np
 from scipy.spatial.transform import Rotation
+
+from bifilar.identification.periods import crossing_times
 
 from .trajectory import Trajectory
 
@@ -73,3 +75,59 @@ def differences(ref: Trajectory, other: Trajectory) -> dict[str, tuple[np.ndarra
 def overlap(ref: Trajectory, other: Trajectory) -> np.ndarray:
     """The samples of ``ref`` inside the time span of ``other`` (a boolean mask)."""
     return (ref.t >= other.t[0] - 1e-12) & (ref.t <= other.t[-1] + 1e-12)
+
+
+def signals(traj: Trajectory) -> dict[str, tuple[np.ndarray, str, float]]:
+    """The scalar signals that describe a run's motion: name -> (values, unit, scale). A rig's run
+    (``com`` and ``quat``): the components of the body's rotation vector (rad, world frame) and of the
+    COM's displacement from its start (m, world frame; scale: the longest wire, so that a swing and a
+    turn compare as angles). Any other system (a seed pendulum): the components of its ``q``
+    channel if it has one, else of every channel but ``energy`` (scale 1)."""
+    n = len(traj.t)
+    out = {}
+    if "quat" in traj and "com" in traj:
+        rotvec = Rotation.from_quat(np.asarray(traj["quat"]), scalar_first=True).as_rotvec()
+        spec = traj.meta.get("rig_spec")
+        length = max((w.length for w in spec.wires), default=1.0) if spec is not None else 1.0
+        com = np.asarray(traj["com"], dtype=float)
+        for k, axis in enumerate("xyz"):
+            out[f"rotation about world {axis}"] = (rotvec[:, k], "rad", 1.0)
+            out[f"COM {axis} displacement"] = (com[:, k] - com[0, k], "m", length)
+        return out
+    names = ["q"] if "q" in traj else [c for c in traj.channels if c != "energy"]
+    for c in names:
+        values = np.asarray(traj[c])
+        if values.dtype.kind not in "fiu" or values.ndim not in (1, 2) or len(values) != n:
+            continue
+        values = values.reshape(n, -1).astype(float)
+        for k in range(values.shape[1]):
+            out[c if values.shape[1] == 1 else f"{c}[{k}]"] = (values[:, k], "", 1.0)
+    return out
+
+
+def dominant(candidates: dict[str, tuple[np.ndarray, str, float]]) -> str | None:
+    """The name of the signal of :func:`signals` with the largest range over its scale (None: none)."""
+
+    def swing(name: str) -> float:
+        values, _, scale = candidates[name]
+        finite = values[np.isfinite(values)]
+        return float(np.ptp(finite)) / scale if finite.size else -1.0
+
+    return max(candidates, key=swing, default=None)
+
+
+def cycle_periods(traj: Trajectory) -> tuple[str, np.ndarray, np.ndarray] | None:
+    """The period of the run's :func:`dominant` signal cycle by cycle: (its name, the first sample
+    time at or after each cycle's end (s), that cycle's period (s)), from the signal's rising
+    crossings of its mid-range (refined between samples); None for fewer than two crossings or a
+    signal that is not finite throughout."""
+    candidates = signals(traj)
+    name = dominant(candidates)
+    if name is None or not np.all(np.isfinite(candidates[name][0])):
+        return None
+    x = candidates[name][0]
+    times = crossing_times(traj.t, x, 0.5 * (x.max() + x.min()))
+    if len(times) < 2:
+        return None
+    ends = traj.t[np.minimum(np.searchsorted(traj.t, times[1:]), len(traj.t) - 1)]
+    return name, ends, np.diff(times)

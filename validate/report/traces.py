@@ -3,14 +3,8 @@ each engine's difference from the reference, small enough to carry back from a w
 
 A case hands its runs to ``ctx.keep`` (for recordings too); :func:`comparisons` groups them as the
 recordings do (:func:`validate.compare.compared`: the first run of each rig is the reference, the
-runs of that rig by other engines are compared with it) and picks, per group, the signal that moves
-most in the reference run:
-
-* a rig (runs with ``com`` and ``quat``): the body's rotation vector components (rad, world frame)
-  and the COM's displacement from its start (m, world frame) divided by the longest wire, so that
-  a swing and a turn compare as angles;
-* any other system (a seed pendulum): the components of its ``q`` channel if it has one, else of
-  every channel but ``energy``.
+runs of that rig by other engines are compared with it) and draws, per group, the signal that moves
+most in the reference run (:func:`validate.compare.dominant`).
 
 Each line is thinned to at most :data:`POINTS` buckets, each keeping its smallest and largest sample
 (in time order), so the peaks a metric measures stay in the figure.
@@ -22,9 +16,8 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.spatial.transform import Rotation
 
-from ..compare import compared, overlap, rig_name
+from ..compare import compared, dominant, overlap, rig_name, signals
 from ..lineplot import Panel, Series, render_png
 from ..trajectory import Trajectory
 
@@ -61,9 +54,9 @@ def comparisons(trajectories: Sequence[Trajectory], points: int = POINTS) -> lis
     out = []
     for ref, others in groups.values():
         candidates = signals(ref)
-        if not candidates:
+        name = dominant(candidates)
+        if name is None:
             continue
-        name = max(candidates, key=lambda k: _swing(candidates[k]))
         unit = candidates[name][1]
         traces, diffs = [_thin(ref.engine, ref.t, candidates[name][0], points)], []
         for other in others:
@@ -77,36 +70,6 @@ def comparisons(trajectories: Sequence[Trajectory], points: int = POINTS) -> lis
         if diffs:
             out.append(Comparison(rig_name(ref), name, unit, ref.engine, tuple(traces), tuple(diffs)))
     return out
-
-
-def signals(traj: Trajectory) -> dict[str, tuple[np.ndarray, str, float]]:
-    """Candidate signals of a run: name -> (values, unit, scale that makes it comparable)."""
-    n = len(traj.t)
-    out = {}
-    if "quat" in traj and "com" in traj:
-        rotvec = Rotation.from_quat(np.asarray(traj["quat"]), scalar_first=True).as_rotvec()
-        spec = traj.meta.get("rig_spec")
-        length = max((w.length for w in spec.wires), default=1.0) if spec is not None else 1.0
-        com = np.asarray(traj["com"], dtype=float)
-        for k, axis in enumerate("xyz"):
-            out[f"rotation about world {axis}"] = (rotvec[:, k], "rad", 1.0)
-            out[f"COM {axis} displacement"] = (com[:, k] - com[0, k], "m", length)
-        return out
-    names = ["q"] if "q" in traj else [c for c in traj.channels if c != "energy"]
-    for c in names:
-        values = np.asarray(traj[c])
-        if values.dtype.kind not in "fiu" or values.ndim not in (1, 2) or len(values) != n:
-            continue
-        values = values.reshape(n, -1).astype(float)
-        for k in range(values.shape[1]):
-            out[c if values.shape[1] == 1 else f"{c}[{k}]"] = (values[:, k], "", 1.0)
-    return out
-
-
-def _swing(candidate: tuple[np.ndarray, str, float]) -> float:
-    values, _, scale = candidate
-    finite = values[np.isfinite(values)]
-    return float(np.ptp(finite)) / scale if finite.size else -1.0
 
 
 def _thin(label: str, t: np.ndarray, y: np.ndarray, points: int) -> Line:
