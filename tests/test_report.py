@@ -133,6 +133,7 @@ def test_html_names_every_case_and_metric_and_renders(tmp_path, capsys, failing_
         assert m.name in words and m.reason in words and f"{m.value:.3e}" in words
     assert words.index(f"{FAILING}: FAIL") < words.index("pendulum-planar-A: PASS")
     assert len(page.images) == 2  # the spherical pendulum (MuJoCo vs the thesis's 4.5.7) and the demo
+    assert f"python -m validate all -k '{CASES}' --jobs 1 --html {path}" in words
     for version in ("mujoco", "numpy", "scipy", "numba", "python"):
         assert f"{version} " in words
 

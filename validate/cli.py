@@ -11,6 +11,7 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import shlex
 import sys
 import traceback
 import warnings
@@ -125,6 +126,7 @@ def main(argv: list[str] | None = None) -> int:
         warnings.simplefilter("always")
         try:
             args = build_parser().parse_args(argv)
+            args.argv = list(sys.argv[1:] if argv is None else argv)  # the command line, for the reports
             _check_outputs(args)
             code = _COMMANDS[args.command](args)
             sys.stdout.flush()
@@ -412,7 +414,13 @@ def _reports(args, cases) -> list:
         from .report.suite_page import write_suite_html
 
         descriptions = {c.name: c.description for c in cases}
-        out.append(lambda results, seconds: write_suite_html(args.html, results, seconds, descriptions))
+        extra = []
+        if getattr(args, "slow", False):  # the stored speed-accuracy result: benchmarks/speed_accuracy.py
+            from .report.speed_accuracy import SpeedAccuracySection, load
+
+            extra.append(SpeedAccuracySection(load()))
+        command = "python -m validate " + shlex.join(args.argv)
+        out.append(lambda results, seconds: write_suite_html(args.html, results, seconds, descriptions, extra, command))
     return out
 
 

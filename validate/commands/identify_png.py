@@ -17,6 +17,11 @@ from ..trajectory import atomic_write_bytes
 
 def draw(trials, path: str) -> None:
     """Write the figure of ``trials`` (:class:`bifilar.identification.trials.Trial`) to ``path`` whole."""
+    atomic_write_bytes(path, render(trials))
+
+
+def render(trials) -> bytes:
+    """The figure of ``trials`` as PNG bytes (``identify --png``, and the fit in ``identify --html``)."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -50,4 +55,4 @@ def draw(trials, path: str) -> None:
     buffer = io.BytesIO()
     fig.savefig(buffer, format="png", dpi=90)
     plt.close(fig)
-    atomic_write_bytes(path, buffer.getvalue())
+    return buffer.getvalue()

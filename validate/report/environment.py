@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import os
 import platform
-import sys
 from importlib import metadata
 
 PACKAGES = ("mujoco", "numpy", "scipy", "numba", "rerun-sdk")
@@ -24,7 +23,7 @@ def versions() -> dict[str, str]:
 def machine() -> dict[str, str]:
     """Host name, operating system, processor and its number of cores."""
     return {"host": platform.node() or "unknown", "system": platform.platform(), "processor": _cpu(),
-            "cores": str(os.cpu_count() or "unknown"), "interpreter": sys.executable}
+            "cores": str(os.cpu_count() or "unknown")}
 
 
 def _cpu() -> str:

@@ -9,8 +9,6 @@ from __future__ import annotations
 
 import datetime
 import math
-import shlex
-import sys
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -103,7 +101,7 @@ def summary_section(results: Sequence[CaseResult], seconds: float, command: str)
                         ("pass" if n_fail == 0 else "fail"))),
         ("cases, metrics", f"{len(results)} cases, {n_metrics} metrics ({n_failed_metrics} failed)"),
         ("wall time", f"{seconds:.1f} s (the cases' own times add up to {sum(r.seconds for r in results):.1f} s)"),
-        ("command", command),
+        ("command", command or "-"),
         ("finished", datetime.datetime.now().astimezone().replace(microsecond=0).isoformat()),
         ("machine", f"{host['host']}: {host['processor']}, {host['cores']} cores; {host['system']}"),
         ("versions", ", ".join(f"{k} {val}" for k, val in v.items())),
@@ -125,9 +123,9 @@ def overview_section(results: Sequence[CaseResult]) -> Table:
 
 
 def suite_page(results: Sequence[CaseResult], seconds: float, descriptions: dict[str, str] | None = None,
-               extra: Sequence[Section] = (), command: str | None = None) -> Page:
-    """The page of ``results`` (see the module docstring); ``extra`` sections go after the cases."""
-    command = command or "python -m validate " + shlex.join(sys.argv[1:])
+               extra: Sequence[Section] = (), command: str = "") -> Page:
+    """The page of ``results`` (see the module docstring): ``descriptions`` case name -> what it checks,
+    ``extra`` sections after the cases, ``command`` the command line that ran them."""
     descriptions = descriptions or {}
     page = Page("bifilar-validate: validation report", "Every case's metrics against tolerances that come from "
                 "reasoning (integrator tolerance, constraint softness), the reason stated beside each.")
@@ -138,6 +136,7 @@ def suite_page(results: Sequence[CaseResult], seconds: float, descriptions: dict
 
 
 def write_suite_html(path: str | Path, results: Sequence[CaseResult], seconds: float,
-                     descriptions: dict[str, str] | None = None, extra: Sequence[Section] = ()) -> Path:
+                     descriptions: dict[str, str] | None = None, extra: Sequence[Section] = (),
+                     command: str = "") -> Path:
     """Write :func:`suite_page` to ``path`` whole or not at all."""
-    return suite_page(results, seconds, descriptions, extra).write(path)
+    return suite_page(results, seconds, descriptions, extra, command).write(path)
