@@ -8,10 +8,10 @@ fitted law T0 (1 + s A^2) (the series of the fitted law, for reading only).
 
 from __future__ import annotations
 
-import io
 
 import numpy as np
 
+from ..report.figures import png_bytes, pyplot
 from ..trajectory import atomic_write_bytes
 
 
@@ -22,10 +22,7 @@ def draw(trials, path: str) -> None:
 
 def render(trials) -> bytes:
     """The figure of ``trials`` as PNG bytes (``identify --png``, and the fit in ``identify --html``)."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = pyplot()
 
     from bifilar.identification.signals import cycles
 
@@ -51,8 +48,4 @@ def render(trials) -> bytes:
         row[2].set(title="period against amplitude", xlabel=f"cycle amplitude ({tr.record.kind} units)",
                    ylabel="period (s)")
         row[2].legend(fontsize=8)
-    fig.tight_layout()
-    buffer = io.BytesIO()
-    fig.savefig(buffer, format="png", dpi=90)
-    plt.close(fig)
-    return buffer.getvalue()
+    return png_bytes(fig)

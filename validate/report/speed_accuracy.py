@@ -11,10 +11,10 @@ its time steps, the hand-derived model as points at its tolerances.
 
 from __future__ import annotations
 
-import io
 import json
 from pathlib import Path
 
+from .figures import png_bytes, pyplot
 from .html import join, number, table, tag
 from .page import Section
 from .sections import figure
@@ -36,10 +36,7 @@ def load(path: str | Path = STORED) -> dict | None:
 
 def figure_png(data: dict) -> bytes:
     """The figure (see the module docstring) as PNG bytes."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = pyplot()
 
     rigs = list(dict.fromkeys(p["rig"] for p in data["points"]))
     fig, axes = plt.subplots(len(rigs), 2, figsize=(12, 4.6 * len(rigs)), squeeze=False)
@@ -70,11 +67,7 @@ def figure_png(data: dict) -> bytes:
         row[0].legend(fontsize=7, ncol=2, loc="best")
     fig.suptitle(f"speed against accuracy, {data['duration']:g} s of torsion per run ({data['date']}; one run each, "
                  "side by side, on a shared machine)", fontsize=10)
-    fig.tight_layout()
-    buffer = io.BytesIO()
-    fig.savefig(buffer, format="png", dpi=90)
-    plt.close(fig)
-    return buffer.getvalue()
+    return png_bytes(fig)
 
 
 class SpeedAccuracySection(Section):

@@ -13,7 +13,6 @@ from __future__ import annotations
 
 import bisect
 import csv
-import io
 import json
 import math
 from collections.abc import Iterator, Sequence
@@ -23,6 +22,7 @@ import numpy as np
 
 from bifilar.sweep.choose import objective
 
+from .figures import png_bytes, pyplot
 from .html import join, number, table, tag
 from .page import Page, Section
 from .sections import Facts, Table, Text, Warnings, figure
@@ -98,10 +98,7 @@ class _Reduction:
             self.least[at] = min(self.least[at], objective(row, self.measure, kind))
 
     def figure(self, summary: dict) -> bytes:
-        import matplotlib
-
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
+        plt = pyplot()
         from matplotlib.colors import LogNorm
 
         fig, (left, right) = plt.subplots(1, 2, figsize=(12, 4.6))
@@ -135,11 +132,7 @@ class _Reduction:
                    color="tab:orange", label="Pareto front")
         right.set(xlabel="peak tension (N)", ylabel="objective (%)", yscale="log", title="objective against peak tension")
         right.legend(fontsize=8)
-        fig.tight_layout()
-        buffer = io.BytesIO()
-        fig.savefig(buffer, format="png", dpi=90)
-        plt.close(fig)
-        return buffer.getvalue()
+        return png_bytes(fig)
 
 
 class MapsSection(Section):
