@@ -141,3 +141,23 @@ def test_html_names_every_case_and_metric_and_renders(tmp_path, capsys, failing_
     check_not_blank(image)
     dom_words = " ".join(dom.split())
     assert "2 passed, 1 failed" in dom_words and "1.000e-03" in dom_words
+
+
+def test_case_writes_junit_and_html_of_its_one_case(tmp_path, capsys):
+    junit, page = tmp_path / "case.xml", tmp_path / "case.html"
+    assert main(["case", "pendulum-spherical-4.5", "--junit", str(junit), "--html", str(page)]) == 0
+    capsys.readouterr()
+    suite = ET.parse(junit).getroot().find("testsuite")
+    assert [c.get("name") for c in suite.iter("testcase")] == ["pendulum-spherical-4.5"]
+    assert (suite.get("tests"), suite.get("failures"), suite.get("errors")) == ("1", "0", "0")
+    words = page_text(check_self_contained(page.read_text()))
+    assert "1 passed, 0 failed" in words and "pendulum-spherical-4.5: PASS" in words
+
+
+def test_an_unwritable_report_path_is_exit_2_before_any_case_runs(tmp_path, capsys):
+    (tmp_path / "r.html").mkdir()
+    assert main(["all", "-k", "pendulum-*", "--html", str(tmp_path / "r.html")]) == 2
+    assert main(["all", "-k", "pendulum-*", "--junit", "/proc/nope/j.xml"]) == 2
+    _, err = capsys.readouterr()
+    assert err.splitlines() == [f"error: {tmp_path / 'r.html'}: cannot write (is a directory)",
+                                "error: /proc/nope/j.xml: cannot write (No such file or directory)"]
