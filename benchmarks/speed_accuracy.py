@@ -111,7 +111,8 @@ def main() -> None:
             else:
                 print(f"| {name} | {engine} | {label} | {result['period_error']:.1e} | {result['length_error']:.1e} "
                       f"| {result['wall_per_second']:.3g} | {result['cpu_per_second']:.3g} |")
-    data = {"command": "python benchmarks/speed_accuracy.py" + (f" --duration {args.duration:g}" if args.duration != 8.0 else ""),
+    options = f" --duration {args.duration:g}" if args.duration != 8.0 else ""
+    data = {"command": "python benchmarks/speed_accuracy.py" + options,
             "date": datetime.date.today().isoformat(), "duration": args.duration, "dt_out": DT_OUT,
             "machine": machine(), "versions": versions(),
             "note": "one run of each setting, side by side in one process on a machine shared with other jobs: "

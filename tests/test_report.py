@@ -161,3 +161,29 @@ def test_an_unwritable_report_path_is_exit_2_before_any_case_runs(tmp_path, caps
     _, err = capsys.readouterr()
     assert err.splitlines() == [f"error: {tmp_path / 'r.html'}: cannot write (is a directory)",
                                 "error: /proc/nope/j.xml: cannot write (No such file or directory)"]
+
+
+def test_slow_html_ends_with_the_stored_speed_accuracy_result(tmp_path, capsys):
+    from validate.report.speed_accuracy import SpeedAccuracySection, load
+
+    stored = load()
+    assert stored is not None, "docs/speed_accuracy.json: python benchmarks/speed_accuracy.py writes it"
+    path = tmp_path / "slow.html"
+    assert main(["all", "--slow", "-k", "pendulum-planar-A", "--html", str(path)]) == 0
+    capsys.readouterr()
+    page = check_self_contained(path.read_text())
+    words = page_text(page)
+    assert words.index("pendulum-planar-A: PASS") < words.index("Speed and accuracy")
+    assert f"measured {stored['date']}" in words and len(page.images) == 1  # the figure; planar-A compares nothing
+    for p in stored["points"]:
+        assert f"{p['rig']} {p['engine']} {p['label']}" in words
+    assert "No stored result at /nowhere.json" in page_text(parse_section(SpeedAccuracySection(None, "/nowhere.json")))
+    assert main(["all", "-k", "pendulum-planar-A", "--html", str(path)]) == 0  # without --slow: no such section
+    capsys.readouterr()
+    assert "Speed and accuracy" not in path.read_text()
+
+
+def parse_section(section):
+    from page_check import parse
+
+    return parse(section.html())

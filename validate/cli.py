@@ -59,7 +59,8 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("all", help="run every registered validation case", epilog=EPILOG)
     p.add_argument("--json", metavar="REPORT.json", help="also write the report as JSON (default: none)")
-    p.add_argument("--slow", action="store_true", help="include cases tagged slow (default: fast cases only)")
+    p.add_argument("--slow", action="store_true", help="include cases tagged slow (default: fast cases only); with "
+                                                        "--html, also the stored result of benchmarks/speed_accuracy.py")
     p.add_argument("-k", metavar="PATTERN", dest="pattern",
                    help="only cases whose name contains PATTERN (or matches it, with * ? [ ]; default: all)")
     p.add_argument("--tag", action="append", metavar="TAG",

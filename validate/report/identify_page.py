@@ -139,10 +139,10 @@ def identify_page(report: dict, trials: Sequence, command: str, files: dict[str,
     if "tare" in report:
         obj = report["object"]
         flags += [f"fixture: {f}" for f in report["tare"]["flags"]] + [f"object: {f}" for f in obj["flags"]]
-        page.add(result_section(report["tare"], "Fixture (tare)"),
-                 Facts("Object (rig minus fixture)", [("mass", number(obj["mass"], 6, "kg")),
-                                                      ("COM (body frame)", ", ".join(number(x, 6) for x in obj["com"]) + " m"),
-                                                      (f"I_{a}{a} about its own COM", _pm(obj["inertia"], obj["std"], UNIT))]))
+        page.add(result_section(report["tare"], "Fixture (tare)"), Facts("Object (rig minus fixture)", [
+            ("mass", number(obj["mass"], 6, "kg")),
+            ("COM (body frame)", ", ".join(number(x, 6) for x in obj["com"]) + " m"),
+            (f"I_{a}{a} about its own COM", _pm(obj["inertia"], obj["std"], UNIT))]))
     page.add(Warnings("Warnings", flags), FitSection(report, trials), budget_section(report), tensor_section(report),
              InputsSection(command, files))
     return page

@@ -71,8 +71,9 @@ class CaseSection(Section):
         for note in r.notes:
             parts.append(tag("p", f"note: {note}"))
         for c in r.traces:
-            parts.append(figure(trace_figure(c), f"{c.system}: {c.signal} of each engine ({', '.join(l.label for l in c.traces)}) "
-                                                 f"and the difference of each from {c.reference}"))
+            engines = ", ".join(line.label for line in c.traces)
+            parts.append(figure(trace_figure(c), f"{c.system}: {c.signal} of each engine ({engines}) and the "
+                                                 f"difference of each from {c.reference}"))
         return join(parts)
 
 
