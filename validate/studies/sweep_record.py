@@ -34,6 +34,7 @@ from ..trajectory import Trajectory
 from .sweep_check import Checked
 
 TIMELINE = "configuration"
+MODES = 4  # a row's periods: sweep.csv's period_1 .. period_4 (None for a neutral or absent mode)
 SIGMAS = ("x", "y", "z")
 
 
@@ -48,19 +49,18 @@ def record_sweep(path: str | Path, space: Space, rows: list[dict], checked: list
         lines.append(f"MuJoCo check rank{rank} ({values}): largest period difference "
                      f"{c.entry['period_rel_error']:.2e}, {'ok' if c.entry['ok'] else 'FAILED'}")
     return record(path, f"sweep of {Path(space.source).name}", runs, note="\n".join(lines),
-                  extra=Extra(partial(_log_table, space=space, rows=rows), _views(space, rows)), timeline=TIMELINE)
+                  extra=Extra(partial(_log_table, space=space, rows=rows), _views(space)), timeline=TIMELINE)
 
 
-def _views(space: Space, rows: list[dict]) -> tuple:
+def _views(space: Space) -> tuple:
     """The map; sigmas and objective, periods and peak tension over the configurations; the table."""
-    n_periods = max((len(r["periods"]) for r in rows), default=0)
 
     def plot(name: str, entities: list[str]) -> rrb.TimeSeriesView:
         return rrb.TimeSeriesView(origin="sweep/series", name=name, contents=[f"+ $origin/{e}" for e in entities])
 
     per_configuration = rrb.Vertical(
         plot("relative sigma", ["objective"] + [f"sigma_{a}" for a in space.measure]),
-        plot("periods (s)", [f"period_{k}" for k in range(1, n_periods + 1)]),
+        plot("periods (s)", [f"period_{k}" for k in range(1, MODES + 1)]),
         plot("peak tension (N)", ["tension_peak"]), name="per configuration")
     table = rrb.DataframeView(origin="sweep/series", name="table",
                               query=rrb.archetypes.DataframeQuery(timeline=TIMELINE))
@@ -84,9 +84,8 @@ def _log_table(rec: rr.RecordingStream, space: Space, rows: list[dict]) -> None:
         series(f"sigma_{a}", sigma, np.isfinite(sigma))
     peak = np.array([math.nan if r["tension_peak"] is None else r["tension_peak"] for r in rows], dtype=float)
     series("tension_peak", peak, np.isfinite(peak))
-    for k in range(max((len(r["periods"]) for r in rows), default=0)):
-        period = np.array([math.nan if k >= len(r["periods"]) or r["periods"][k] is None else r["periods"][k]
-                           for r in rows], dtype=float)
+    for k in range(MODES):
+        period = np.array([math.nan if r["periods"][k] is None else r["periods"][k] for r in rows], dtype=float)
         series(f"period_{k + 1}", period, np.isfinite(period))
     series("feasible", np.array([1.0 if r["feasible"] else 0.0 for r in rows]), np.ones(len(rows), dtype=bool))
     for a in space.axes:
