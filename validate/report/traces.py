@@ -94,6 +94,6 @@ def figure(c: Comparison) -> bytes:
                    for i, line in enumerate(c.traces))
     diffs = tuple(Series(line.t, line.y, line.label, RGB[(i + 1) % len(RGB)])
                   for i, line in enumerate(c.differences))
-    return render_png([Panel(f"{c.system}: {c.signal}{unit}, each engine", c.unit, traces),
-                       Panel(f"{c.system}: {c.signal}{unit}, difference from {c.reference}", c.unit, diffs,
+    return render_png([Panel(f"{c.system}: {c.signal}{unit}, each engine", "", traces),
+                       Panel(f"{c.system}: {c.signal}{unit}, difference from {c.reference}", "", diffs,
                              ((0.0, (120, 120, 120)),))], "t (s)")
