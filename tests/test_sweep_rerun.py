@@ -1,6 +1,7 @@
 """``sweep --rerun``: DIR/sweep.rrd read back with rerun's own reader holds the table of sweep.csv (the
-objective and sigmas per configuration, bit for bit; infeasible rows marked) and the MuJoCo check's
-motion; a path that cannot be written is exit 2 before any work."""
+objective, sigmas and periods per configuration, bit for bit; infeasible rows marked) and the MuJoCo
+check's motion, and opens on the configuration timeline with the map, the series and the table; a path
+that cannot be written is exit 2 before any work."""
 
 import csv
 import json
@@ -8,6 +9,7 @@ import time
 
 import numpy as np
 from rerun.chunk import RrdReader
+from rrd_check import timeline, verify, views
 
 from validate.cli import main
 from validate.recording import SLACK_RGB
@@ -78,6 +80,21 @@ def test_rerun_holds_the_table_and_the_mujoco_motion(tmp_path, capsys):
     span = (body["sim_time"][-1] - body["sim_time"][0]).total_seconds()
     assert abs(span - CYCLES * mode["predicted"]) <= mode["predicted"] / 200  # one sample step
     assert "MuJoCo check rank1" in rec["summary"]["TextDocument:text"][0][0]
+
+    # the periods per configuration, bit for bit, where a row has them (vertical wires: mode 1, the
+    # tilt about the line through the attachments, is neutral and has none)
+    assert not any(r["period_1"] for r in rows) and "Scalars:scalars" not in rec["sweep/series/period_1"]
+    for k in (2, 3, 4):
+        period = rec[f"sweep/series/period_{k}"]
+        assert period["configuration"] == [i for i, r in enumerate(rows) if r[f"period_{k}"]]
+        assert [v[0] for v in period["Scalars:scalars"]] == [float(rows[i][f"period_{k}"]) for i in period["configuration"]]
+
+    # the layout: opens on the configuration timeline, with the map, the series and the table
+    verify(out / "sweep.rrd")
+    assert timeline(out / "sweep.rrd") == "configuration"
+    shown = views(out / "sweep.rrd")
+    assert shown["configurations"] == ("3D", "sweep/map") and shown["table"] == ("Dataframe", "sweep/series")
+    assert shown["periods (s)"] == ("TimeSeries", "sweep/series") and shown["rig"] == ("3D", "world")
 
 
 def test_a_bad_rerun_path_is_exit_2_before_any_work(tmp_path, capsys):

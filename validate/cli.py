@@ -11,6 +11,7 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import shlex
 import sys
 import traceback
 import warnings
@@ -58,7 +59,8 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("all", help="run every registered validation case", epilog=EPILOG)
     p.add_argument("--json", metavar="REPORT.json", help="also write the report as JSON (default: none)")
-    p.add_argument("--slow", action="store_true", help="include cases tagged slow (default: fast cases only)")
+    p.add_argument("--slow", action="store_true", help="include cases tagged slow (default: fast cases only); with "
+                                                        "--html, also the stored result of benchmarks/speed_accuracy.py")
     p.add_argument("-k", metavar="PATTERN", dest="pattern",
                    help="only cases whose name contains PATTERN (or matches it, with * ? [ ]; default: all)")
     p.add_argument("--tag", action="append", metavar="TAG",
@@ -66,6 +68,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--jobs", type=whole_number("--jobs", 1, 64), default=2,
                    help="cases run in parallel worker processes, 1-64 (default: 2)")
     p.add_argument("--rerun", metavar="DIR", help="also write one rerun recording per case, DIR/<case>.rrd (default: none)")
+    _report_options(p)
 
     sub.add_parser("list", help="list the registered cases with their whole descriptions")
 
@@ -74,6 +77,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--json", metavar="REPORT.json", help="also write the report as JSON (default: none)")
     p.add_argument("--rerun", metavar="FILE.rrd",
                    help="also write a rerun recording of the case, open with: rerun FILE.rrd (default: none)")
+    _report_options(p)
 
     p = sub.add_parser("modes", help="rest pose, static tensions and small-oscillation periods", epilog=EPILOG)
     p.add_argument("rig", help="rig file (TOML), e.g. models/rigs/plate.toml")
@@ -109,6 +113,13 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def _report_options(p) -> None:
+    p.add_argument("--junit", metavar="FILE.xml", help="also write the results as JUnit XML, for CI servers (default: none)")
+    p.add_argument("--html", metavar="FILE.html",
+                   help="also write one self-contained HTML page: summary, every case's metrics and figures "
+                        "(default: none)")
+
+
 def main(argv: list[str] | None = None) -> int:
     """Run one command; returns its exit status (see :data:`EPILOG`)."""
     args = None
@@ -116,6 +127,7 @@ def main(argv: list[str] | None = None) -> int:
         warnings.simplefilter("always")
         try:
             args = build_parser().parse_args(argv)
+            args.argv = list(sys.argv[1:] if argv is None else argv)  # the command line, for the reports
             _check_outputs(args)
             code = _COMMANDS[args.command](args)
             sys.stdout.flush()
@@ -230,7 +242,7 @@ def _check_outputs(args) -> None:
     """Every output path is checked writable before the work starts (:func:`check_writable`)."""
     from .trajectory import check_writable
 
-    for name in ("out", "json", "rerun", "png"):
+    for name in ("out", "json", "rerun", "png", "junit", "html"):
         value = getattr(args, name, None)
         if not isinstance(value, str):
             continue
@@ -381,13 +393,36 @@ def _cmd_all(args) -> int:
 
     cases = select(registered(slow=args.slow or bool(args.tag)), args.pattern, args.tag)
     return run_cases(cases, jobs=args.jobs, json_path=args.json, on_result=_recorder(args.rerun, folder=True),
-                     progress=True)
+                     progress=True, reports=_reports(args, cases), traces=bool(args.html))
 
 
 def _cmd_case(args) -> int:
     from .suite import find, run_cases
 
-    return run_cases([find(args.name)], jobs=1, json_path=args.json, on_result=_recorder(args.rerun, folder=False))
+    cases = [find(args.name)]
+    return run_cases(cases, jobs=1, json_path=args.json, on_result=_recorder(args.rerun, folder=False),
+                     reports=_reports(args, cases), traces=bool(args.html))
+
+
+def _reports(args, cases) -> list:
+    """The writers of ``--junit`` and ``--html``, each called with the results and the wall time."""
+    out = []
+    if args.junit:
+        from .report.junit import write_junit
+
+        out.append(lambda results, seconds: write_junit(args.junit, results, seconds))
+    if args.html:
+        from .report.suite_page import write_suite_html
+
+        descriptions = {c.name: c.description for c in cases}
+        extra = []
+        if getattr(args, "slow", False):  # the stored speed-accuracy result: benchmarks/speed_accuracy.py
+            from .report.speed_accuracy import SpeedAccuracySection, load
+
+            extra.append(SpeedAccuracySection(load()))
+        command = "python -m validate " + shlex.join(args.argv)
+        out.append(lambda results, seconds: write_suite_html(args.html, results, seconds, descriptions, extra, command))
+    return out
 
 
 def _recorder(dest: str | None, folder: bool):

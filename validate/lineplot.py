@@ -57,7 +57,14 @@ def nice_ticks(low: float, high: float, count: int = 5) -> np.ndarray:
 
 
 def save_png(path: str | Path, panels: list[Panel], xlabel: str) -> Path:
-    """Draw the panels over a shared x range and write the PNG; returns the path."""
+    """Draw the panels over a shared x range and write the PNG (:func:`render_png`); returns the path."""
+    path = Path(path)
+    atomic_write_bytes(path, render_png(panels, xlabel))
+    return path
+
+
+def render_png(panels: list[Panel], xlabel: str) -> bytes:
+    """The panels drawn over a shared x range, as the bytes of a PNG file."""
     font = ImageFont.load_default(size=FONT_SIZE)
     left, right, top, bottom = MARGIN
     height = len(panels) * (PANEL_HEIGHT + top) + bottom
@@ -101,11 +108,9 @@ def save_png(path: str | Path, panels: list[Panel], xlabel: str) -> Path:
         draw.text((box[0] - 6, box[1] - 6), panel.ylabel, fill=AXIS_RGB, font=font, anchor="rb")
         _legend(draw, font, panel, box)
     draw.text((WIDTH - right, height - 8), xlabel, fill=AXIS_RGB, font=font, anchor="rb")
-    path = Path(path)
     png = io.BytesIO()
     image.quantize(colors=64).save(png, format="PNG", optimize=True)
-    atomic_write_bytes(path, png.getvalue())
-    return path
+    return png.getvalue()
 
 
 def _legend(draw: ImageDraw.ImageDraw, font, panel: Panel, box) -> None:

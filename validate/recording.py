@@ -3,10 +3,12 @@
 One recording holds every trajectory a case kept, overlaid in one 3D scene: the ceiling anchors, each
 wire coloured by its tension (viridis from 0 to the largest tension in the recording, red when slack)
 and labelled with it, the body as its inertia-equivalent box with its axes, and a trail of its COM.
-Every channel is also a time series on the ``sim_time`` timeline, and for runs of one rig by
-different engines the difference from the first engine, on that engine's time grid. The case's
-metrics and verdict are a text document. The default blueprint opens on the 3D view, the tensions,
-the thesis angles and the differences; the other channels are tabs beside the metrics.
+Every channel is also a time series on the ``sim_time`` timeline, so is each run's period cycle by
+cycle (of the signal that moves most: :func:`validate.compare.cycle_periods`), and for runs of one
+rig by different engines the difference from the first engine, on that engine's time grid. The
+case's metrics and verdict are a text document. The default blueprint opens on the ``sim_time``
+timeline (or the one :func:`record` is given), with the 3D view, the tensions, the periods, the
+thesis angles and the differences; the other channels are tabs beside the metrics.
 
 Trajectories without a rig (seed pendula) are plotted only. Time-varying data goes through
 ``send_columns``, one call per entity, so that recording costs little next to simulating
@@ -32,6 +34,7 @@ from scipy.spatial.transform import Rotation
 
 from bifilar.bodies.composite import equivalent_box
 
+from .compare import by_rig, columns, compared, cycle_periods, differences
 from .registry import Metric
 from .trajectory import RIG_CHANNELS, Trajectory, check_writable
 
@@ -46,9 +49,9 @@ SLACK_RGB = (230, 30, 30)  # tension <= 0 (slack, or an equality cable pushing):
 VIRIDIS = np.array([(68, 1, 84), (71, 44, 122), (59, 81, 139), (44, 113, 142), (33, 144, 141),
                     (39, 173, 129), (92, 200, 99), (170, 220, 50), (253, 231, 37)], dtype=float)
 RUN_RGB = ((31, 119, 180), (255, 127, 14), (44, 160, 44), (148, 103, 189), (140, 86, 75), (227, 119, 194))
-MAIN_PLOTS = ("tension", "theta")  # plotted in full view; every other channel gets a tab
+MAIN_PLOTS = ("tension", "period", "theta")  # plotted in full view; every other channel gets a tab
 UNITS = {"com": "m", "tension": "N", "length_error": "m", "velocity": "m/s", "omega": "rad/s",
-         "energy": "J", "theta": "rad", "attitude": "rad"}
+         "energy": "J", "theta": "rad", "attitude": "rad", "period": "s"}
 
 
 @dataclass(frozen=True)
@@ -78,12 +81,13 @@ class Extra:
 
 
 def record(path: str | Path, title: str, trajectories: Sequence[Trajectory], metrics: Iterable[Metric] = (),
-           passed: bool | None = None, note: str = "", extra: Extra | None = None) -> Path:
+           passed: bool | None = None, note: str = "", extra: Extra | None = None, timeline: str = TIMELINE) -> Path:
     """Write one .rrd of ``trajectories`` (see the module docstring) with ``metrics``, the verdict
-    ``passed`` (None: no verdict), a free ``note`` (e.g. the error a case raised) and ``extra``.
-    Returns the path."""
+    ``passed`` (None: no verdict), a free ``note`` (e.g. the error a case raised) and ``extra``; the
+    viewer opens on ``timeline``. Returns the path."""
     runs = _runs(trajectories)
-    diffs = [(ref, run, differences(ref.traj, run.traj)) for ref, run in _compared(runs)]
+    diffs = [(ref, run, differences(ref.traj, run.traj)) for ref, run in compared(runs, _rig, _engine)]
+    periods = {r.label: p for r in runs if (p := cycle_periods(r.traj)) is not None}
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     check_writable(path)
@@ -91,12 +95,12 @@ def record(path: str | Path, title: str, trajectories: Sequence[Trajectory], met
     tmp = path.with_name(f".{path.name[:48]}.{uuid.uuid4().hex}.rrd")
     try:
         rec = rr.RecordingStream(APP_ID)
-        rec.save(tmp, default_blueprint=_blueprint(runs, diffs, extra.views if extra else ()))
+        rec.save(tmp, default_blueprint=_blueprint(runs, diffs, periods, extra.views if extra else (), timeline))
         rec.send_recording_name(title)
         if extra:
             extra.log(rec)
         _log_scene(rec, [r for r in runs if r.drawn])
-        _log_series(rec, runs, diffs)
+        _log_series(rec, runs, diffs, periods)
         rec.log("summary", rr.TextDocument(_summary(title, runs, list(metrics), passed, note),
                                            media_type=rr.MediaType.MARKDOWN), static=True)
         rec.flush()
@@ -147,11 +151,12 @@ def _runs(trajectories: Sequence[Trajectory]) -> list[_Run]:
     return runs
 
 
-def _by_rig(runs: list[_Run]) -> dict[str, list[_Run]]:
-    groups: dict[str, list[_Run]] = {}
-    for r in runs:
-        groups.setdefault(r.rig, []).append(r)
-    return groups
+def _rig(run: _Run) -> str:
+    return run.rig
+
+
+def _engine(run: _Run) -> str:
+    return run.traj.engine
 
 
 def _time(t: np.ndarray) -> list[rr.TimeColumn]:
@@ -183,7 +188,7 @@ def _log_scene(rec: rr.RecordingStream, runs: list[_Run]) -> None:
     rec.log("world", rr.ViewCoordinates.RIGHT_HAND_Z_UP, static=True)
     t_max = max(float(np.nanmax(r.traj["tension"], initial=0.0)) for r in runs) or 1.0
     x = last_reach = 0.0
-    for rig_name, group in _by_rig(runs).items():
+    for rig_name, group in by_rig(runs, _rig).items():
         rig = group[0].traj.meta["rig_spec"]
         reach = max(abs(w.anchor[0]) for w in rig.wires) + max(w.length for w in rig.wires)  # in x, from x = 0
         x += 1.1 * (last_reach + reach) if last_reach else 0.0
@@ -237,59 +242,25 @@ def _components(channel: str, k: int) -> list[str]:
     return [channel] if k == 1 else [f"{channel}[{i}]" for i in range(k)]
 
 
-def _columns(traj: Trajectory) -> dict[str, np.ndarray]:
-    """Every numeric channel as an (n, k) float array."""
-    n = len(traj.t)
-    out = {}
-    for name, values in traj.channels.items():
-        arr = np.asarray(values)
-        if arr.dtype.kind in "fiub" and arr.ndim in (1, 2) and len(arr) == n:
-            out[name] = arr.reshape(n, -1).astype(float, copy=False)
-    return out
-
-
 def _send_series(rec: rr.RecordingStream, entity: str, t: np.ndarray, values: np.ndarray, names: list[str]) -> None:
     rec.log(entity, rr.SeriesLines(names=names), static=True)
     rec.send_columns(entity, _time(t), rr.Scalars.columns(scalars=values))
 
 
-def _log_series(rec: rr.RecordingStream, runs: list[_Run], diffs: list) -> None:
-    """``plots/<channel>/<run>`` for every channel and ``diff/<channel>/<run>`` for every difference."""
+def _log_series(rec: rr.RecordingStream, runs: list[_Run], diffs: list, periods: dict) -> None:
+    """``plots/<channel>/<run>`` for every channel, ``plots/period/<run>`` for the period cycle by
+    cycle (:func:`validate.compare.cycle_periods`) and ``diff/<channel>/<run>`` for every difference."""
     for run in runs:
-        for name, values in _columns(run.traj).items():
+        for name, values in columns(run.traj).items():
             names = [f"{run.label} {c}" for c in _components(name, values.shape[1])]
             _send_series(rec, f"plots/{name}/{run.label}", run.traj.t, values, names)
+        if run.label in periods:
+            signal, t, values = periods[run.label]
+            _send_series(rec, f"plots/period/{run.label}", t, values[:, None], [f"{run.label} period of {signal}"])
     for ref, run, channels in diffs:
         for name, (t, values) in channels.items():
             names = [f"{run.label} - {ref.label} {c}" for c in _components(name, values.shape[1])]
             _send_series(rec, f"diff/{name}/{run.label}", t, values, names)
-
-
-def _compared(runs: list[_Run]) -> list[tuple[_Run, _Run]]:
-    """(reference, other) pairs: the first run of each rig against that rig's runs by other engines."""
-    return [(g[0], r) for g in _by_rig(runs).values() for r in g[1:] if r.traj.engine != g[0].traj.engine]
-
-
-def differences(ref: Trajectory, other: Trajectory) -> dict[str, tuple[np.ndarray, np.ndarray]]:
-    """``other - ref`` for each channel both carry with the same width, on ``ref``'s times within the
-    overlap of the two runs (``other`` interpolated linearly: exact where the grids coincide). The
-    quaternion channel becomes ``attitude``, the rotation angle (rad) from ``ref``'s attitude to
-    ``other``'s, which does not depend on the quaternions' signs."""
-    keep = (ref.t >= other.t[0] - 1e-12) & (ref.t <= other.t[-1] + 1e-12)
-    t = ref.t[keep]
-    a, b = _columns(ref), _columns(other)
-    out = {}
-    for name in a.keys() & b.keys():
-        if a[name].shape[1] != b[name].shape[1]:
-            continue
-        theirs = np.column_stack([np.interp(t, other.t, col) for col in b[name].T])
-        if name == "quat":
-            angle = (Rotation.from_quat(a[name][keep], scalar_first=True).inv()
-                     * Rotation.from_quat(theirs, scalar_first=True)).magnitude()
-            out["attitude"] = (t, angle[:, None])
-        else:
-            out[name] = (t, theirs - a[name][keep])
-    return dict(sorted(out.items()))
 
 
 # ---------------------------------------------------------------------------------------- summary, layout
@@ -321,18 +292,20 @@ def _plot(origin: str, channel: str, what: str) -> rrb.TimeSeriesView:
     return rrb.TimeSeriesView(origin=origin, name=f"{what} ({unit})" if unit else what)
 
 
-def _blueprint(runs: list[_Run], diffs: list, extra_views: tuple = ()) -> rrb.Blueprint:
+def _blueprint(runs: list[_Run], diffs: list, periods: dict, extra_views: tuple = (),
+               timeline: str = TIMELINE) -> rrb.Blueprint:
     """3D scene on the left; tensions, thesis angles and differences on the right, the other
-    channels in tabs behind the metrics; ``extra_views`` in tabs before all that."""
-    channels = list(dict.fromkeys(c for r in runs for c in _columns(r.traj)))
+    channels in tabs behind the metrics; ``extra_views`` in tabs before all that; the time panel on
+    ``timeline``."""
+    channels = list(dict.fromkeys(c for r in runs for c in columns(r.traj))) + (["period"] if periods else [])
     main = [c for c in MAIN_PLOTS if c in channels]
     rest = [c for c in channels if c not in main]
-    if not main:  # no rig channels: the system's own channels are what matters
-        main, rest = rest, []
-    compared = sorted({c for _, _, channels in diffs for c in channels}, key=lambda c: (c not in MAIN_PLOTS, c))
+    if not set(main) - {"period"}:  # no rig channels: the system's own channels are what matters
+        main, rest = main + rest, []
+    differenced = sorted({c for _, _, channels in diffs for c in channels}, key=lambda c: (c not in MAIN_PLOTS, c))
     panels: list = [_plot(f"plots/{c}", c, c) for c in main]
-    if compared:
-        panels.append(rrb.Tabs(*[_plot(f"diff/{c}", c, f"{c} difference") for c in compared]))
+    if differenced:
+        panels.append(rrb.Tabs(*[_plot(f"diff/{c}", c, f"{c} difference") for c in differenced]))
     panels.append(rrb.Tabs(rrb.TextDocumentView(origin="summary", name="metrics"),
                            *[_plot(f"plots/{c}", c, c) for c in rest]))
     right = rrb.Vertical(*panels)
@@ -348,4 +321,4 @@ def _blueprint(runs: list[_Run], diffs: list, extra_views: tuple = ()) -> rrb.Bl
     if extra_views:
         layout = rrb.Tabs(*extra_views, layout)
     return rrb.Blueprint(layout, rrb.BlueprintPanel(state="collapsed"), rrb.SelectionPanel(state="collapsed"),
-                         rrb.TimePanel(timeline=TIMELINE, state="collapsed"))
+                         rrb.TimePanel(timeline=timeline, state="collapsed"))

@@ -3,7 +3,8 @@
 A case is a function that runs one or more engines on one system and returns :class:`Metric`s, each
 a measured value, the tolerance it must meet and the reason for that tolerance. Register it with
 :func:`case`; ``python -m validate all`` runs every case tagged ``fast`` (``--slow`` adds ``slow``).
-Trajectories a case wants recorded (rerun) are handed to ``ctx.keep``.
+Trajectories a case wants recorded (rerun) and drawn in the HTML report (runs of one rig by several
+engines: their traces and differences, :mod:`validate.report.traces`) are handed to ``ctx.keep``.
 """
 
 from __future__ import annotations

@@ -13,13 +13,17 @@ import time
 import traceback
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import asdict, dataclass, field
-from typing import Callable
+from typing import Callable, Sequence
 
 from .registry import REGISTRY, Case, CaseContext, Metric
 
 
 @dataclass
 class CaseResult:
+    """One case's outcome. ``group`` is the module the case is defined in (``trifilar``); the runs the
+    case kept are in ``trajectories`` (for a recording) or ``traces`` (for a report:
+    :func:`validate.report.traces.comparisons`), only when asked for."""
+
     name: str
     source: str
     passed: bool
@@ -27,6 +31,14 @@ class CaseResult:
     metrics: list[Metric]
     error: str | None = None
     trajectories: list = field(default_factory=list)
+    group: str = ""
+    notes: list[str] = field(default_factory=list)
+    traces: list = field(default_factory=list)
+
+
+# What a suite run hands its results to, besides the table: e.g. a JUnit or an HTML writer; called
+# with the results in the order of the cases and the run's wall time (s).
+Report = Callable[[list[CaseResult], float], object]
 
 
 def registered(slow: bool = False) -> list[Case]:
@@ -64,8 +76,9 @@ def find(name: str) -> Case:
     return cases[name]
 
 
-def run_case(name: str, keep_trajectories: bool = False) -> CaseResult:
-    """Run one case by name (in this process)."""
+def run_case(name: str, keep_trajectories: bool = False, keep_traces: bool = False) -> CaseResult:
+    """Run one case by name (in this process); with ``keep_trajectories`` its kept runs come back
+    whole, with ``keep_traces`` as the report's comparisons."""
     c = find(name)
     ctx = CaseContext()
     start = time.perf_counter()
@@ -76,15 +89,26 @@ def run_case(name: str, keep_trajectories: bool = False) -> CaseResult:
         metrics, error = [], f"{type(exc).__name__}: {exc}\n{traceback.format_exc()}"
     seconds = time.perf_counter() - start
     passed = error is None and bool(metrics) and all(m.passed for m in metrics)
-    return CaseResult(c.name, c.source, passed, seconds, metrics, error, ctx.trajectories if keep_trajectories else [])
+    traces = []
+    if keep_traces:
+        from .report.traces import comparisons
+
+        try:
+            traces = comparisons(ctx.trajectories)
+        except Exception as exc:  # the case's verdict stands; the report says why it has no figure
+            ctx.notes.append(f"the report could not draw this case's runs ({type(exc).__name__}: {exc})")
+    return CaseResult(c.name, c.source, passed, seconds, metrics, error, ctx.trajectories if keep_trajectories else [],
+                      c.run.__module__.rsplit(".", 1)[-1], list(ctx.notes), traces)
 
 
 def run_cases(cases: list[Case], jobs: int = 2, json_path: str | None = None,
-              on_result: Callable[[CaseResult], object] | None = None, progress: bool = False) -> int:
+              on_result: Callable[[CaseResult], object] | None = None, progress: bool = False,
+              reports: Sequence[Report] = (), traces: bool = False) -> int:
     """Run the cases, print the table (and write the JSON report); 0 if all passed, else 1.
     ``on_result`` is called on every result in this process (e.g. to record it); only then are the
-    trajectories carried back from the workers. With ``progress``, each case is announced on stderr
-    as it finishes, with its verdict and wall time."""
+    trajectories carried back from the workers. ``reports`` are then handed every result and the
+    wall time; with ``traces`` the results carry the comparisons a report draws. With ``progress``,
+    each case is announced on stderr as it finishes, with its verdict and wall time."""
     names = [c.name for c in cases]
     keep = on_result is not None
     start = time.perf_counter()
@@ -99,12 +123,13 @@ def run_cases(cases: list[Case], jobs: int = 2, json_path: str | None = None,
 
     if jobs > 1 and len(names) > 1:
         with ProcessPoolExecutor(max_workers=jobs) as pool:
-            for future in as_completed([pool.submit(run_case, n, keep) for n in names]):
+            for future in as_completed([pool.submit(run_case, n, keep, traces) for n in names]):
                 finished(future.result())
     else:
         for n in names:
-            finished(run_case(n, keep))
+            finished(run_case(n, keep, traces))
     results = [done[n] for n in names]
+    seconds = time.perf_counter() - start
     print(format_table(results))
     if on_result is not None:
         for r in results:
@@ -114,6 +139,8 @@ def run_cases(cases: list[Case], jobs: int = 2, json_path: str | None = None,
         from .trajectory import atomic_write_text
 
         atomic_write_text(json_path, json.dumps(report(results), indent=1) + "\n")
+    for write in reports:
+        write(results, seconds)
     return 0 if passed else 1
 
 

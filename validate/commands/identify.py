@@ -71,6 +71,8 @@ def add_parser(subparsers) -> None:
     p.add_argument("--samples", type=whole_number("--samples", 100), help="Monte Carlo draws instead of linear propagation")
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.add_argument("--png", metavar="FILE.png", help="draw each record, its fit, residuals and period against amplitude")
+    p.add_argument("--html", metavar="FILE.html", help="write one self-contained page: the result, the fits, the "
+                                                       "variance budget, the tensor check and the inputs")
 
 
 def run(args) -> int:
@@ -86,6 +88,10 @@ def run(args) -> int:
         from .identify_png import draw
 
         draw(trials, args.png)
+    if args.html:
+        from ..report.identify_page import write_identify_html
+
+        write_identify_html(args.html, report, trials, args)
     if args.json:
         print(json.dumps(_clean(report), allow_nan=False))
         return 0

@@ -8,19 +8,21 @@ fitted law T0 (1 + s A^2) (the series of the fitted law, for reading only).
 
 from __future__ import annotations
 
-import io
 
 import numpy as np
 
+from ..report.figures import png_bytes, pyplot
 from ..trajectory import atomic_write_bytes
 
 
 def draw(trials, path: str) -> None:
     """Write the figure of ``trials`` (:class:`bifilar.identification.trials.Trial`) to ``path`` whole."""
-    import matplotlib
+    atomic_write_bytes(path, render(trials))
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+
+def render(trials) -> bytes:
+    """The figure of ``trials`` as PNG bytes (``identify --png``, and the fit in ``identify --html``)."""
+    plt = pyplot()
 
     from bifilar.identification.signals import cycles
 
@@ -46,8 +48,4 @@ def draw(trials, path: str) -> None:
         row[2].set(title="period against amplitude", xlabel=f"cycle amplitude ({tr.record.kind} units)",
                    ylabel="period (s)")
         row[2].legend(fontsize=8)
-    fig.tight_layout()
-    buffer = io.BytesIO()
-    fig.savefig(buffer, format="png", dpi=90)
-    plt.close(fig)
-    atomic_write_bytes(path, buffer.getvalue())
+    return png_bytes(fig)

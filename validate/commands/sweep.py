@@ -7,7 +7,8 @@ empty where not measured or not identifiable), ``clearance`` (m above the floor)
 ``motion_1..motion_4``, ``dominant_x..z`` (the uncertainty group with the largest share), ``separation``
 (smallest relative gap between two mode periods), ``reason`` (why a row is infeasible) and
 ``air_share_x..z`` (for a rig with ``[air]``: the air's share of each measured period, 1 - (T_vacuum/T)^2)), and
-``DIR/summary.json`` (n, feasible, objective, best, pareto, seconds, mujoco_check). ``--check-mujoco K``
+``DIR/summary.json`` (n, feasible, objective, best, pareto, seconds, mujoco_check) and ``DIR/report.html``
+(one self-contained page of them: :mod:`validate.report.sweep_page`). ``--check-mujoco K``
 runs the K best configurations in MuJoCo (:mod:`validate.studies.sweep_check`) and fails (exit 1) on a
 disagreement over 1e-6. ``--png`` adds ``DIR/sweep.png``:
 the objective over the two most varied axes (the best over the others), infeasible points marked, and the
@@ -192,6 +193,9 @@ def run(args) -> int:
     atomic_write_text(out / "summary.json", json.dumps(data, indent=1, allow_nan=False) + "\n")
     if args.png:
         figure(space, rows, out / "sweep.png")
+    from ..report.sweep_page import write_sweep_html
+
+    write_sweep_html(out, space.measure, space.objective, f"sweep of {Path(args.space).name}")
     if args.rerun:
         from ..studies.sweep_record import record_sweep
 
@@ -204,7 +208,8 @@ def run(args) -> int:
                  f"{100 * top['objective']:.3g} %, peak tension {top['tension_peak']:.4g} N")
     print(f"sweep {Path(args.space).name}: {data['n']} configurations, {data['feasible']} feasible, "
           f"{seconds:.1f} s on {1 if args.scheduler is None and jobs == 1 else jobs} worker(s); {best_text}; "
-          f"wrote {out / 'sweep.csv'}, {out / 'summary.json'}" + (f", {out / 'sweep.rrd'}" if args.rerun else ""))
+          f"wrote {out / 'sweep.csv'}, {out / 'summary.json'}, {out / 'report.html'}"
+          + (f", {out / 'sweep.rrd'}" if args.rerun else ""))
     if data["mujoco_check"]:
         worst = max(c["period_rel_error"] for c in data["mujoco_check"])
         print(f"MuJoCo check of the {len(data['mujoco_check'])} best: largest period difference {worst:.2e}"

@@ -2,13 +2,18 @@
 
 The table, on a ``configuration`` timeline (the row index, grid order, as in ``sweep.csv``):
 ``sweep/series/objective`` and ``sweep/series/sigma_<axis>`` (relative, feasible rows only),
-``sweep/series/tension_peak`` (N), ``sweep/series/feasible`` (1 or 0, every row) and
-``sweep/series/axes/<axis>`` (the varied values, m); and, static, ``sweep/map``: every configuration as
+``sweep/series/tension_peak`` (N), ``sweep/series/period_<k>`` (s, the k-th longest mode, rows that
+have it), ``sweep/series/feasible`` (1 or 0, every row) and ``sweep/series/axes/<axis>`` (the varied
+values, m); and, static, ``sweep/map``: every configuration as
 a point at its values of the (up to) three most varied axes (world x, y, z = those axes, m), coloured by
 the objective (viridis from 0 to the largest feasible objective; red: infeasible), labelled with its
 values, sigmas and, if infeasible, the reason; ``sweep/map/best`` marks the best. The runs of the
 MuJoCo check (each measured mode of each checked configuration, named ``rank<n>_<axis>``) are drawn and
 plotted by :func:`validate.recording.record`, which also writes the file whole or not at all.
+
+The viewer opens on the ``configuration`` timeline, with tabs before the check's runs: the map in 3D,
+the sigmas, periods and peak tension per configuration, and the table (every series, one row per
+configuration).
 """
 
 from __future__ import annotations
@@ -29,6 +34,7 @@ from ..trajectory import Trajectory
 from .sweep_check import Checked
 
 TIMELINE = "configuration"
+MODES = 4  # a row's periods: sweep.csv's period_1 .. period_4 (None for a neutral or absent mode)
 SIGMAS = ("x", "y", "z")
 
 
@@ -42,10 +48,23 @@ def record_sweep(path: str | Path, space: Space, rows: list[dict], checked: list
         values = ", ".join(f"{a} = {v:g}" for a, v in c.entry["configuration"].items())
         lines.append(f"MuJoCo check rank{rank} ({values}): largest period difference "
                      f"{c.entry['period_rel_error']:.2e}, {'ok' if c.entry['ok'] else 'FAILED'}")
-    views = (rrb.Spatial3DView(origin="sweep/map", name="configurations"),
-             rrb.TimeSeriesView(origin="sweep/series", name="per configuration"))
     return record(path, f"sweep of {Path(space.source).name}", runs, note="\n".join(lines),
-                  extra=Extra(partial(_log_table, space=space, rows=rows), views))
+                  extra=Extra(partial(_log_table, space=space, rows=rows), _views(space)), timeline=TIMELINE)
+
+
+def _views(space: Space) -> tuple:
+    """The map; sigmas and objective, periods and peak tension over the configurations; the table."""
+
+    def plot(name: str, entities: list[str]) -> rrb.TimeSeriesView:
+        return rrb.TimeSeriesView(origin="sweep/series", name=name, contents=[f"+ $origin/{e}" for e in entities])
+
+    per_configuration = rrb.Vertical(
+        plot("relative sigma", ["objective"] + [f"sigma_{a}" for a in space.measure]),
+        plot("periods (s)", [f"period_{k}" for k in range(1, MODES + 1)]),
+        plot("peak tension (N)", ["tension_peak"]), name="per configuration")
+    table = rrb.DataframeView(origin="sweep/series", name="table",
+                              query=rrb.archetypes.DataframeQuery(timeline=TIMELINE))
+    return (rrb.Spatial3DView(origin="sweep/map", name="configurations"), per_configuration, table)
 
 
 def _log_table(rec: rr.RecordingStream, space: Space, rows: list[dict]) -> None:
@@ -65,6 +84,9 @@ def _log_table(rec: rr.RecordingStream, space: Space, rows: list[dict]) -> None:
         series(f"sigma_{a}", sigma, np.isfinite(sigma))
     peak = np.array([math.nan if r["tension_peak"] is None else r["tension_peak"] for r in rows], dtype=float)
     series("tension_peak", peak, np.isfinite(peak))
+    for k in range(MODES):
+        period = np.array([math.nan if r["periods"][k] is None else r["periods"][k] for r in rows], dtype=float)
+        series(f"period_{k + 1}", period, np.isfinite(period))
     series("feasible", np.array([1.0 if r["feasible"] else 0.0 for r in rows]), np.ones(len(rows), dtype=bool))
     for a in space.axes:
         series(f"axes/{a}", np.array([r["values"][a] for r in rows]), np.ones(len(rows), dtype=bool))

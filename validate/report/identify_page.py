@@ -1,0 +1,157 @@
+"""The page of an identification (``identify ... --html FILE``): the moment with its uncertainty, the
+warnings, each record's fit with its residuals and its period against amplitude beside the fitted
+law, the variance budget, the check of the identified tensor, and the inputs (the options given and
+the rig files as read).
+
+Built from the command's report dict (the one ``--json`` prints, docs/identification.md) and its
+fitted trials (:class:`bifilar.identification.trials.Trial`), so the page shows what the command
+computed and nothing else.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from pathlib import Path
+
+from .html import Raw, join, number, table, tag
+from .page import Page, Section
+from .sections import Facts, Table, Text, Warnings, figure
+
+UNIT = "kg m^2"
+
+
+def _pm(value, std, unit: str = "", digits: int = 9) -> str:
+    text = number(value, digits)
+    if std is not None:
+        text += f" ± {number(std, 3)}"
+    return f"{text} {unit}".strip()
+
+
+def result_section(report: dict, title: str = "Result") -> Facts:
+    a = report["axis"]
+    items = [("rig", report["rig"]), (f"I_{a}{a}", _pm(report["inertia"], report["std"], UNIT))]
+    if report["interval95"]:
+        items.append(("95 % interval", f"{number(report['interval95'][0], 9)} .. {number(report['interval95'][1], 9)} "
+                                       f"{UNIT} ({report['method']})"))
+    items += [("sigma: repeatability", number(report["std_repeatability"], 3, UNIT)),
+              ("sigma: rig geometry and mass", number(report["std_rig"], 3, UNIT)),
+              ("I / m", _pm(report["inertia_per_mass"], report["std_per_mass"], "m^2")),
+              ("radius of gyration", _pm(report["radius_of_gyration"], report["radius_of_gyration_std"], "m", 6)),
+              ("period at zero amplitude", _pm(report["period"], report["period_std"], "s") +
+               f" ({report['period_std_source']})"),
+              ("d ln T / d ln I", number(report["sensitivity"], 4)),
+              ("start value", report["start_value"])]
+    if report.get("timed_period") is not None:
+        items.append(("period as timed", f"{number(report['timed_period'], 9)} s at amplitude "
+                                         f"{number(report['amplitude'][0], 4)} rad"))
+    if "air_share" in report:
+        items += [("without the air", _pm(report["inertia_without_air"], report["inertia_without_air_std"], UNIT)),
+                  ("the air's share", f"{100.0 * report['air_share']:.2f} % of the measured moment")]
+    if len(report["trials"]) > 1:
+        items.append(("between trials", f"std {number(report['between_trial_std'], 3, UNIT)}, chi^2 per degree "
+                                        f"of freedom {number(report['chi2_per_dof'], 3)}"))
+    return Facts(title, items)
+
+
+def trials_table(report: dict) -> Raw:
+    rows = []
+    for i, tr in enumerate(report["trials"], start=1):
+        amp = tr["amplitude"]
+        second = tr["second_mode"]
+        rows.append((i, tr["source"], _pm(tr["period"], tr["period_std"], "s"), _pm(tr["inertia"], tr["std"], UNIT),
+                     "scale unknown" if amp is None else f"{number(amp[0], 3)} -> {number(amp[1], 3)}",
+                     f"{number(tr['damping']['linear'], 3)} + {number(tr['damping']['quadratic'], 3)} |w|",
+                     f"{number(tr['amplitude_coefficient'], 4)} ± {number(tr['amplitude_coefficient_std'], 2)} ({tr['law']})",
+                     number(tr["residual_rms"], 3), f"{len(tr['outliers'])} of {tr['samples']}",
+                     "-" if second is None else f"{number(second['period'], 4)} s"))
+    return table(("trial", "record", "T0", "I", "amplitude (start -> end)", "damping", "T(A)/T0 - 1 per A^2",
+                  "residual rms", "rejected", "second mode"), rows)
+
+
+class FitSection(Section):
+    """Each record with its fit, its residuals and its period against amplitude (the fitted law)."""
+
+    title = "Fit"
+    open = True
+
+    def __init__(self, report: dict, trials: Sequence):
+        self.report, self.trials = report, trials
+
+    def body(self) -> str:
+        if not self.trials:
+            return tag("p", "A measured period was given: no record was fitted.")
+        from ..commands.identify_png import render
+
+        caption = ("each record with its fit (rejected samples marked), the residuals, and each cycle's period "
+                   "against its amplitude beside the fitted law T0 (1 + s A^2)")
+        return join([figure(render(self.trials), caption), trials_table(self.report)])
+
+
+def budget_section(report: dict) -> Section:
+    if not report["budget"]:
+        return Text("Variance budget", ["No uncertainty was propagated: nothing to share out."])
+    groups = sorted(report["budget"], key=lambda g: -report["budget"][g])
+    rows = [(g, f"{100.0 * report['budget'][g]:.2f} %", f"{100.0 * report['budget_per_mass'][g]:.2f} %")
+            for g in groups]
+    return Table("Variance budget", ("uncertainty group", f"share of var(I_{report['axis'] * 2})", "share of var(I / m)"),
+                 rows, note="Each [uncertainty] group's share of the variance (the period group is the repeatability).")
+
+
+def tensor_section(report: dict) -> Table:
+    rows = []
+    for label, key in (("identified tensor", "tensor_check"), ("without the air", "tensor_check_without_air")):
+        check = report.get(key)
+        if check:
+            rows.append((label, ", ".join(number(x, 6) for x in check["principal"]),
+                         "yes" if check["positive_definite"] else "NO", "yes" if check["triangle"] else "NO"))
+    return Table("Tensor check", ("tensor", f"principal moments ({UNIT})", "positive definite", "triangle inequality"),
+                 rows, note="The rig file's tensor with the identified moment in place: a body's tensor is positive "
+                            "definite and its principal moments obey the triangle inequality.",
+                 row_classes=[None if r[2] == r[3] == "yes" else "fail" for r in rows])
+
+
+class InputsSection(Section):
+    """The command line and every rig file as read."""
+
+    title = "Inputs"
+    open = False
+
+    def __init__(self, command: str, files: dict[str, str]):
+        self.command, self.files = command, files
+
+    def body(self) -> str:
+        parts = [tag("p", "command:"), tag("pre", self.command)]
+        for label, path in self.files.items():
+            try:
+                text = Path(path).read_text()
+            except OSError as exc:
+                text = f"(could not be read again: {exc.strerror})"
+            parts += [tag("p", f"{label}: {path}"), tag("pre", text)]
+        return join(parts)
+
+
+def identify_page(report: dict, trials: Sequence, command: str, files: dict[str, str]) -> Page:
+    """The page (see the module docstring); ``command`` the command line, ``files`` label -> rig file."""
+    a = report["axis"]
+    page = Page(f"identify {report['rig']}: I_{a}{a}", f"{_pm(report['inertia'], report['std'], UNIT)}")
+    flags = list(report["flags"])
+    page.add(result_section(report))
+    if "tare" in report:
+        obj = report["object"]
+        flags += [f"fixture: {f}" for f in report["tare"]["flags"]] + [f"object: {f}" for f in obj["flags"]]
+        page.add(result_section(report["tare"], "Fixture (tare)"), Facts("Object (rig minus fixture)", [
+            ("mass", number(obj["mass"], 6, "kg")),
+            ("COM (body frame)", ", ".join(number(x, 6) for x in obj["com"]) + " m"),
+            (f"I_{a}{a} about its own COM", _pm(obj["inertia"], obj["std"], UNIT))]))
+    page.add(Warnings("Warnings", flags), FitSection(report, trials), budget_section(report), tensor_section(report),
+             InputsSection(command, files))
+    return page
+
+
+def write_identify_html(path: str | Path, report: dict, trials: Sequence, args) -> Path:
+    """Write the page of an ``identify`` run (its report dict, its trials and its ``args``) whole."""
+    import shlex
+
+    files = {"rig": args.rig, **({"fixture": args.tare} if args.tare else {})}
+    command = "python -m validate " + shlex.join(getattr(args, "argv", ["identify", args.rig, "..."]))
+    return identify_page(report, trials, command, files).write(path)
