@@ -6,7 +6,7 @@ import math
 import numpy as np
 import pytest
 
-from bifilar.identification import records as R
+from bifilar.identification.records import read as R
 from bifilar.rig import RigError
 
 T = np.arange(40) / 60.0

@@ -14,7 +14,7 @@ from dataclasses import replace
 import numpy as np
 
 from bifilar.bodies.air import Air, added_inertia, added_mass_principal
-from bifilar.identification.signals import fit_oscillation
+from bifilar.identification.records import fit_oscillation
 from bifilar.motion.modes import linearize
 
 from ..assets import rig
@@ -110,7 +110,8 @@ def kane_mujoco(ctx: CaseContext):
 
 @case("air-decay-fit", source="Jardin & Mueller (AIAA 2007-6822); MuJoCo fluid.rst", engines=("kane",))
 def decay_fit(ctx: CaseContext):
-    """The wing's yaw decay fitted (signals.fit_oscillation) against the drag it was simulated with."""
+    """The wing's yaw decay fitted (records.fit_oscillation: its description of the decay) against the drag it
+    was simulated with."""
     r = wing()
     traj = engines()["kane"](r, 12.0, 0.01, RTOL)
     ctx.keep(traj)
@@ -120,8 +121,8 @@ def decay_fit(ctx: CaseContext):
     i_d = 8.0 * np.pi / 15.0 * semi[2] * max(semi[0], semi[1]) ** 4  # MuJoCo's I_D about z, the largest
     i_total = float(YAW @ r.inertia @ YAW) + added_inertia(air, r.com, YAW)
     predicted = air.density * air.drag[2] * i_d / i_total  # theta'' + c |theta'| theta' ...: c, 1/rad
-    return [check(f"quadratic damping: fitted {fit.quadratic:.5g} / predicted {predicted:.5g} - 1",
-                  abs(fit.quadratic / predicted - 1.0), 1e-2,
+    return [check(f"quadratic damping: fitted {fit.damping['quadratic']:.5g} / predicted {predicted:.5g} - 1",
+                  abs(fit.damping['quadratic'] / predicted - 1.0), 1e-2,
                   "1-DOF reduction of the swing (the COM moves too) and the fit's trade between the viscous "
                   "and the quadratic term (Stokes' term is 1e-4 of the drag here); measured 1.4e-3")]
 

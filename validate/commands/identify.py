@@ -2,9 +2,10 @@
 
     python -m validate identify RIG.toml --axis x|y|z (--period T [--amplitude A] | --signal FILE ...)
         [--column NAME] [--kind angle|rate|proportional] [--time-column NAME] [--fps F]
-        [--time-unit s|ms] [--angle-unit rad|deg] [--from S] [--to S]
+        [--time-unit s|ms] [--angle-unit rad|deg] [--from S] [--to S] [--law-sigma F]
+        [--amplitude-scale K | --max-amplitude A]
         [--tare FIXTURE.toml (--tare-period T | --tare-signal FILE ...)]
-        [--samples N] [--json] [--png FILE.png]
+        [--samples N] [--json] [--png FILE.png] [--html FILE.html]
 
 The rig file gives the geometry, the mass and the other inertia entries; the moment being identified
 may be ``nan`` there (or any positive start value): the file's value is not checked, the identified
@@ -13,10 +14,11 @@ propagated (docs/identification.md); without it nothing of the rig is propagated
 
 * ``--period T`` (s) timed at peak rotation ``--amplitude A`` (rad; default 0); its sigma is
   ``[uncertainty].period``.
-* ``--signal FILE`` (repeatable: trials of one rig): records read by
-  :func:`bifilar.identification.records.read_record` and fitted with the rig's own amplitude law
-  (:mod:`bifilar.identification.trials`); each trial is reported, and the pooled period goes
-  through the propagation with the rig's sigmas (common to every trial) once.
+* ``--signal FILE`` (repeatable: trials of one rig): records taken through
+  :func:`bifilar.identification.records.pipeline.identify_records` (read, fit cycle by cycle with the
+  rig's amplitude law and its excess learned from the record, swing checked, inverted, halves fitted,
+  pooled); each trial is reported, and the pooled period goes through the propagation with the rig's
+  sigmas (common to every trial) once.
 * ``--tare FIXTURE.toml``: the fixture alone (same body frame as RIG.toml, its own period or
   records); the object's own moment about the axis through its own COM follows by difference and
   the parallel-axis theorem.
@@ -36,6 +38,8 @@ import numpy as np
 
 from bifilar.rig import RigError, load_rig
 
+from bifilar.identification.records.law import EXCESS_PRIOR
+
 from ..argtypes import UsageError, bounded_float, positive_float, whole_number
 
 AXIS_INDEX = {"x": 0, "y": 1, "z": 2}
@@ -46,7 +50,7 @@ def add_parser(subparsers) -> None:
     """Register the ``identify`` subcommand on the CLI's subparsers."""
 
     p = subparsers.add_parser("identify", help="a moment of inertia from measured periods or records, with its uncertainty")
-    p.add_argument("rig")
+    p.add_argument("rig", help="rig file (TOML) holding the body as hung; the unknown moment may be nan there")
     p.add_argument("--axis", required=True, choices=("x", "y", "z"), help="body axis of the unknown moment")
     source = p.add_mutually_exclusive_group(required=True)
     source.add_argument("--period", type=positive_float("--period"), help="measured period, s")
@@ -54,16 +58,23 @@ def add_parser(subparsers) -> None:
     p.add_argument("--amplitude", type=positive_float("--amplitude"), help="peak rotation while timed, rad (with --period)")
     p.add_argument("--column", help="record column (default: the --kind's name, else the only non-time column)")
     p.add_argument("--kind", choices=("angle", "rate", "proportional"), default="angle",
-                   help="what the column holds (default angle; proportional: any unit, scale fitted)")
+                   help="what the column holds (default angle; proportional: any unit, e.g. pixels, its scale "
+                        "unknown: give --amplitude-scale or --max-amplitude for the amplitude correction)")
     p.add_argument("--time-column", help="time column (default: t, time or timestamp; with --fps: frame first)")
     p.add_argument("--fps", type=positive_float("--fps"), help="frames per second: the time column holds frame numbers")
     p.add_argument("--time-unit", choices=("s", "ms"), default="s", help="unit of the time column (default s)")
     p.add_argument("--angle-unit", choices=("rad", "deg"), default="rad", help="angle (or rate) unit (default rad)")
     p.add_argument("--from", dest="start", type=float, metavar="S", help="use the record from this time, s")
     p.add_argument("--to", dest="end", type=float, metavar="S", help="use the record up to this time, s")
-    p.add_argument("--law-sigma", type=bounded_float("--law-sigma", 0.0, math.inf, ""), default=None, metavar="F",
-                   help="relative std allowed for the real rig's amplitude law against the ideal one "
-                        "(default 0.5; 0: the ideal law exactly)")
+    p.add_argument("--law-sigma", type=bounded_float("--law-sigma", 0.0, 10.0, ""), default=None, metavar="F",
+                   help="prior std of the real rig's amplitude-law excess, relative to the ideal coefficient "
+                        f"(default {EXCESS_PRIOR:g}; 0: the ideal law exactly)")
+    scale = p.add_mutually_exclusive_group()
+    scale.add_argument("--amplitude-scale", type=positive_float("--amplitude-scale"), metavar="K",
+                       help="a proportional record's units per rad (e.g. pixels per rad): it is then an angle record")
+    scale.add_argument("--max-amplitude", type=bounded_float("--max-amplitude", 0.0, math.pi, "rad", low_open=True),
+                       metavar="A", help="the largest swing a proportional record can have had, rad: its scale is "
+                                         "fitted within [0, A / first amplitude] and the rest of the doubt is in the sigma")
     p.add_argument("--tare", metavar="FIXTURE.toml", help="the fixture alone, to subtract")
     tare = p.add_mutually_exclusive_group()
     tare.add_argument("--tare-period", type=positive_float("--tare-period"), help="the fixture's period, s")
@@ -106,8 +117,9 @@ def _check_options(args) -> None:
     if args.signal is not None and args.amplitude is not None:
         raise UsageError("identify: --amplitude goes with --period; a --signal's amplitude is fitted")
     uses_signal = args.signal is not None or args.tare_signal is not None
-    record_options = {"--law-sigma": args.law_sigma, "--column": args.column, "--time-column": args.time_column, "--fps": args.fps,
-                      "--from": args.start, "--to": args.end}
+    record_options = {"--law-sigma": args.law_sigma, "--column": args.column, "--time-column": args.time_column,
+                      "--fps": args.fps, "--from": args.start, "--to": args.end, "--amplitude-scale": args.amplitude_scale,
+                      "--max-amplitude": args.max_amplitude}
     record_options["--kind"] = None if args.kind == "angle" else args.kind
     record_options["--time-unit"] = None if args.time_unit == "s" else args.time_unit
     record_options["--angle-unit"] = None if args.angle_unit == "rad" else args.angle_unit
@@ -115,6 +127,9 @@ def _check_options(args) -> None:
         given = [k for k, v in record_options.items() if v is not None]
         if given:
             raise UsageError(f"identify: {given[0]} goes with --signal")
+    if (args.amplitude_scale or args.max_amplitude) and args.kind != "proportional":
+        option = "--amplitude-scale" if args.amplitude_scale else "--max-amplitude"
+        raise UsageError(f"identify: {option} goes with --kind proportional (an angle or a rate has its scale)")
     if args.fps is not None and args.time_unit != "s":
         raise UsageError("identify: --time-unit goes with a time column, not with --fps (frame numbers)")
     if args.start is not None and args.end is not None and args.end <= args.start:
@@ -147,9 +162,7 @@ def _identify(path: str, args, period, signals, amplitude="args"):
     """(report dict, trials) for one rig file (the rig, or a --tare fixture)."""
     from bifilar.identification.air import vacuum, without_air
     from bifilar.identification.identify import axis_vector, identify, pencil, with_moment
-    from bifilar.identification.records import read_record
-    from bifilar.identification.signals import EXCESS_PRIOR
-    from bifilar.identification.trials import fit_trial, pool
+    from bifilar.identification.records.pipeline import identify_records
 
     axis = args.axis
     amplitude = args.amplitude if amplitude == "args" else amplitude
@@ -168,17 +181,15 @@ def _identify(path: str, args, period, signals, amplitude="args"):
             raise
         ratio, small = found.amplitude_ratio, period / found.amplitude_ratio
         small_std = rig.uncertainty.period / ratio
-        period_std_source = "the rig file's [uncertainty].period"
+        period_std_source = ("the rig file's [uncertainty].period" if small_std > 0.0 else
+                             "none: the rig file states no [uncertainty].period")
         pooled = None
     else:
-        for name in signals:
-            record = read_record(name, args.column, args.kind, time_column=args.time_column, fps=args.fps,
-                                 time_unit=args.time_unit, angle_unit=args.angle_unit, start=args.start, end=args.end)
-            prior = EXCESS_PRIOR if args.law_sigma is None else args.law_sigma
-            trials.append(fit_trial(rig, axis, record, p, prior))
-        pooled = pool(trials)
+        trials, pooled = identify_records(rig, axis, signals, _record_options(args), p)
         small, small_std, ratio = pooled.period, pooled.period_std, 1.0
         period_std_source = "the records' fits"
+        for tr in trials:
+            flags.extend(tr.flags)
         if not pooled.consistent:
             flags.append(f"the {len(trials)} trials scatter more than their stated sigmas (chi^2 per degree of "
                          f"freedom {pooled.chi2_per_dof:.3g}): the pooled sigma is scaled by its square root")
@@ -186,15 +197,14 @@ def _identify(path: str, args, period, signals, amplitude="args"):
     report["period_std_source"] = period_std_source
     report["start_value"] = "nan in the rig file" if was_nan else "the rig file's value (a start only)"
     if pooled is None:
-        report.update(amplitude=[amplitude, amplitude] if amplitude else None, damping=None,
-                      amplitude_coefficient=None, residual_rms=None, outliers=None, trials=[],
-                      between_trial_std=None, chi2_per_dof=None)
+        report.update({key: None for key in _PER_RECORD}, trials=[], between_trial_std=None, chi2_per_dof=None)
+        report["amplitude"] = [amplitude, amplitude] if amplitude else None
         if ratio != 1.0:
             report["timed_period"] = period
     else:
         report["trials"] = [_trial(tr, rig.mass) for tr in trials]
         one = report["trials"][0] if len(trials) == 1 else None
-        for key in ("amplitude", "damping", "amplitude_coefficient", "residual_rms", "outliers"):
+        for key in _PER_RECORD:  # one record: its own fields at the top as well
             report[key] = one[key] if one else None
         report["between_trial_std"] = pooled.between_trial_std
         report["chi2_per_dof"] = pooled.chi2_per_dof
@@ -277,14 +287,33 @@ def _tensor_check(inertia: np.ndarray) -> dict:
             "triangle": bool(principal[0] + principal[1] >= principal[2] * (1.0 - 1e-9))}
 
 
+_PER_RECORD = ("amplitude", "damping", "law", "halves", "rejected", "residual_rms", "outliers")
+
+
+def _record_options(args):
+    """identify's record options as the pipeline takes them."""
+    from bifilar.identification.records.pipeline import RecordOptions
+
+    return RecordOptions(args.column, args.kind, args.time_column, args.fps, args.time_unit, args.angle_unit,
+                         args.start, args.end, EXCESS_PRIOR if args.law_sigma is None else args.law_sigma,
+                         args.amplitude_scale, args.max_amplitude)
+
+
 def _trial(tr, mass: float) -> dict:
     """The JSON object of one trial: its fit and the moment from it alone (repeatability sigma)."""
     fit = tr.fit
     z = 1.959963984540054
+    halves = None
+    if tr.halves is not None:
+        h = tr.halves
+        halves = {"first": {"period": h.first[0], "period_std": h.first[1]},
+                  "second": {"period": h.second[0], "period_std": h.second[1]}, "split": h.split, "z": h.z}
     return {
         "source": tr.record.source,
         "period": fit.period,
         "period_std": fit.period_std,
+        "period_std_statistical": fit.period_std_statistical,
+        "period_std_law": fit.period_std_law,
         "period_std_white": fit.period_std_white,
         "inertia": tr.moment,
         "std": tr.moment_std,
@@ -292,17 +321,19 @@ def _trial(tr, mass: float) -> dict:
         "inertia_per_mass": tr.moment / mass,
         "std_per_mass": tr.moment_std / mass,
         "amplitude": list(fit.amplitude) if fit.amplitude is not None else None,
-        "damping": {"linear": fit.zeta, "quadratic": fit.quadratic},
-        "amplitude_coefficient": fit.amplitude_coefficient,
-        "amplitude_coefficient_std": fit.amplitude_coefficient_std,
-        "law": fit.law,
+        "damping": fit.damping,
+        "law": fit.law.as_dict(),
+        "halves": halves,
+        "rejected": fit.rejected.as_dict(),
         "residual_rms": fit.rms,
         "outliers": fit.outliers.tolist(),
         "second_mode": None if fit.second_mode is None else dict(zip(("period", "amplitude", "decay"), fit.second_mode)),
         "samples": fit.samples,
+        "cycles": fit.cycles,
         "dropped": tr.record.dropped,
         "unfolded": tr.record.unfolded,
         "block": fit.block,
+        "flags": list(tr.flags),
     }
 
 
@@ -346,54 +377,96 @@ def _clean(value):
     return value
 
 
+WIDTH = 100  # text reports are wrapped at this many columns
+
+
+def _say(text: str, indent: int = 2) -> None:
+    """One item of the text report, wrapped at :data:`WIDTH` columns, continued further indented."""
+    import textwrap
+
+    print(textwrap.fill(text, WIDTH, initial_indent=" " * indent, subsequent_indent=" " * (indent + 4),
+                        break_on_hyphens=False, break_long_words=False))
+
+
 def _print(report: dict, label: str | None = None) -> None:
     a, unit = report["axis"], "kg m^2"
     name = f"rig {report['rig']}" + (f" ({label})" if label else "")
     if report["std"] is None:
-        print(f"{name}: I_{a}{a} = {report['inertia']:.9g} {unit} (no uncertainty propagated)")
+        _say(f"{name}: I_{a}{a} = {report['inertia']:.9g} {unit} (no uncertainty propagated)", 0)
     else:
         low, high = report["interval95"]
-        print(f"{name}: I_{a}{a} = {report['inertia']:.9g} +- {report['std']:.3g} {unit} "
-              f"(95 %: {low:.9g} .. {high:.9g}; {report['method']})")
+        _say(f"{name}: I_{a}{a} = {report['inertia']:.9g} +- {report['std']:.3g} {unit} "
+             f"(95 %: {low:.9g} .. {high:.9g}; {report['method']})", 0)
     parts = [f"{label} {report[key]:.3g}" for key, label in (("std_repeatability", "repeatability"),
                                                              ("std_rig", "rig geometry and mass")) if report[key]]
     if parts:
-        print("  sigma: " + ", ".join(parts) + f" {unit}")
+        _say("sigma: " + ", ".join(parts) + f" {unit}")
     per = report["inertia_per_mass"]
     spm = report["std_per_mass"]
-    print(f"  I/m = {per:.9g}" + (f" +- {spm:.3g}" if spm is not None else "") + " m^2, radius of gyration "
-          f"{report['radius_of_gyration']:.6g} m")
+    _say(f"I/m = {per:.9g}" + (f" +- {spm:.3g}" if spm is not None else "") + " m^2, radius of gyration "
+         f"{report['radius_of_gyration']:.6g} m")
     std = report["period_std"]
-    print(f"  period (zero amplitude) {report['period']:.9g}" + (f" +- {std:.3g}" if std else "") +
-          f" s ({report['period_std_source']}); d ln T / d ln I = {report['sensitivity']:.3g}")
+    _say(f"period (zero amplitude) {report['period']:.9g}" + (f" +- {std:.3g}" if std else "") +
+         f" s ({report['period_std_source']}); d ln T / d ln I = {report['sensitivity']:.3g}")
     if "air_share" in report:
-        print(f"  without the air: {report['inertia_without_air']:.9g} +- {report['inertia_without_air_std']:.3g} "
-              f"{unit} (the air is {100.0 * report['air_share']:.1f} % of the measured moment)")
+        _say(f"without the air: {report['inertia_without_air']:.9g} +- {report['inertia_without_air_std']:.3g} "
+             f"{unit} (the air is {100.0 * report['air_share']:.1f} % of the measured moment)")
     if report["budget"]:
         shares = sorted(report["budget"].items(), key=lambda kv: -kv[1])
-        print("  variance budget: " + ", ".join(f"{g} {100.0 * s:.1f} %" for g, s in shares))
+        _say("variance budget: " + ", ".join(f"{g} {100.0 * s:.1f} %" for g, s in shares))
         shares = sorted(report["budget_per_mass"].items(), key=lambda kv: -kv[1])
-        print("  variance budget of I/m: " + ", ".join(f"{g} {100.0 * s:.1f} %" for g, s in shares))
+        _say("variance budget of I/m: " + ", ".join(f"{g} {100.0 * s:.1f} %" for g, s in shares))
     for i, tr in enumerate(report["trials"], start=1):
-        amp = tr["amplitude"]
-        amp_text = f"{amp[0]:.3g} -> {amp[1]:.3g} rad" if amp else "scale unknown"
-        second = tr["second_mode"]
-        print(f"  trial {i} {tr['source']}: T0 {tr['period']:.9g} +- {tr['period_std']:.3g} s, I {tr['inertia']:.9g} "
-              f"+- {tr['std']:.3g}; {amp_text}; damping {tr['damping']['linear']:.3g} + {tr['damping']['quadratic']:.3g}"
-              f" |w|; T(A)/T0 - 1 = {tr['amplitude_coefficient']:.4g} A^2 ({tr['law']}); rms {tr['residual_rms']:.3g}; "
-              f"{len(tr['outliers'])} outliers" + (f"; second mode {second['period']:.4g} s" if second else ""))
+        _print_trial(i, tr)
     if len(report["trials"]) > 1:
-        print(f"  between trials: std {report['between_trial_std']:.3g} {unit}, chi^2/dof {report['chi2_per_dof']:.3g}")
-    check = report["tensor_check"]
-    print(f"  identified tensor: principal {', '.join(f'{x:.6g}' for x in check['principal'])}; positive definite "
-          f"{'yes' if check['positive_definite'] else 'NO'}, triangle inequality {'yes' if check['triangle'] else 'NO'}")
+        _say(f"between trials: std {report['between_trial_std']:.3g} {unit}, chi^2/dof {report['chi2_per_dof']:.3g}")
+    # with air, the body's own tensor is the one that must be a body's (the apparent one need not be)
+    check, whose = ((report["tensor_check_without_air"], " (the body's, without the air)")
+                    if "tensor_check_without_air" in report else (report["tensor_check"], ""))
+    _say(f"identified tensor{whose}: principal {', '.join(f'{x:.6g}' for x in check['principal'])}; positive "
+         f"definite {'yes' if check['positive_definite'] else 'NO'}, triangle inequality "
+         f"{'yes' if check['triangle'] else 'NO'}")
     for flag in report["flags"]:
-        print(f"  warning: {flag}")
+        _say(f"warning: {flag}")
+
+
+def _print_trial(i: int, tr: dict) -> None:
+    """A trial in one line each: its result, swing and damping, amplitude law, halves, what was left out."""
+    _say(f"trial {i} {tr['source']}: T0 {tr['period']:.9g} +- {tr['period_std']:.3g} s (record "
+         f"{tr['period_std_statistical']:.2g}, amplitude law {tr['period_std_law']:.2g}), I {tr['inertia']:.9g} "
+         f"+- {tr['std']:.3g} kg m^2")
+    amp, d = tr["amplitude"], tr["damping"]
+    swing = f"{amp[0]:.3g} -> {amp[1]:.3g} rad" if amp else "swing in rad unknown (proportional)"
+    second = tr["second_mode"]
+    _say(f"swing {swing} over {tr['cycles']} cycles; damping {d['linear']:.2g} + {d['quadratic']:.2g} |w| + dry "
+         f"{d['dry']:.2g}; rms {tr['residual_rms']:.3g}" + (f"; second mode {second['period']:.4g} s" if second else ""),
+         4)
+    law = tr["law"]
+    if law["ideal"] is None:
+        _say(f"amplitude law: {law['kind']}" + (f" ({law['note']})" if law["note"] else ""), 4)
+    elif law["excess_std"] == 0.0:
+        _say(f"amplitude law: {law['kind']}, T(A)/T0 - 1 = {law['ideal']:.4g} A^2 + ... (the ideal law, held)", 4)
+    else:
+        rel, rel_std = law["excess"] / law["ideal"], law["excess_std"] / abs(law["ideal"])
+        _say(f"amplitude law: {law['kind']}, ideal {law['ideal']:.4g} A^2, the record's {law['coefficient']:.4g} "
+             f"A^2 (excess {100.0 * rel:+.1f} +- {100.0 * rel_std:.1f} %, {100.0 * law['learned']:.0f} % learned from "
+             "the record, the rest prior)", 4)
+    h = tr["halves"]
+    if h is not None:
+        _say(f"halves: T0 {h['first']['period']:.9g} +- {h['first']['period_std']:.2g} s and "
+             f"{h['second']['period']:.9g} +- {h['second']['period_std']:.2g} s, z = {h['z']:+.2f}", 4)
+    else:
+        _say("halves: a half holds too few cycles to fit alone", 4)
+    r = tr["rejected"]
+    if r["samples"]:
+        spans = ", ".join(f"{a:.4g}..{b:.4g} s" for a, b in r["spans"][:6]) + (" ..." if len(r["spans"]) > 6 else "")
+        _say(f"left out: {r['samples']} samples ({r['cycles']} in whole cycles, {r['glitches']} glitches, "
+             f"{r['stuck']} stuck values; {tr['dropped']} rows had no value): {spans}", 4)
 
 
 def _print_object(obj: dict, axis: str) -> None:
     std = f" +- {obj['std']:.3g}" if obj["std"] is not None else " (no uncertainty propagated)"
-    print(f"object (rig minus fixture, {obj['mass']:.6g} kg at COM {', '.join(f'{x:.6g}' for x in obj['com'])} m): "
-          f"I_{axis}{axis} about its own COM = {obj['inertia']:.9g}{std} kg m^2")
+    _say(f"object (rig minus fixture, {obj['mass']:.6g} kg at COM {', '.join(f'{x:.6g}' for x in obj['com'])} m): "
+         f"I_{axis}{axis} about its own COM = {obj['inertia']:.9g}{std} kg m^2", 0)
     for flag in obj["flags"]:
-        print(f"  warning: {flag}")
+        _say(f"warning: {flag}")

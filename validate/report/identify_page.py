@@ -4,7 +4,7 @@ law, the variance budget, the check of the identified tensor, and the inputs (th
 the rig files as read).
 
 Built from the command's report dict (the one ``--json`` prints, docs/identification.md) and its
-fitted trials (:class:`bifilar.identification.trials.Trial`), so the page shows what the command
+fitted trials (:class:`bifilar.identification.records.pipeline.Trial`), so the page shows what the command
 computed and nothing else.
 """
 
@@ -61,11 +61,28 @@ def trials_table(report: dict) -> Raw:
         rows.append((i, tr["source"], _pm(tr["period"], tr["period_std"], "s"), _pm(tr["inertia"], tr["std"], UNIT),
                      "scale unknown" if amp is None else f"{number(amp[0], 3)} -> {number(amp[1], 3)}",
                      f"{number(tr['damping']['linear'], 3)} + {number(tr['damping']['quadratic'], 3)} |w|",
-                     f"{number(tr['amplitude_coefficient'], 4)} ± {number(tr['amplitude_coefficient_std'], 2)} ({tr['law']})",
-                     number(tr["residual_rms"], 3), f"{len(tr['outliers'])} of {tr['samples']}",
+                     _law(tr["law"]), _halves(tr["halves"]),
+                     number(tr["residual_rms"], 3), f"{tr['rejected']['samples']} of {tr['samples'] + tr['rejected']['samples']}",
                      "-" if second is None else f"{number(second['period'], 4)} s"))
-    return table(("trial", "record", "T0", "I", "amplitude (start -> end)", "damping", "T(A)/T0 - 1 per A^2",
-                  "residual rms", "rejected", "second mode"), rows)
+    return table(("trial", "record", "T0", "I", "amplitude (start -> end)", "damping", "amplitude law", "halves",
+                  "residual rms", "left out", "second mode"), rows)
+
+
+def _law(law: dict) -> str:
+    """The amplitude law of a trial: the coefficient used, and how much the record itself taught."""
+    if law["ideal"] is None:
+        return law["kind"]
+    if law["excess_std"] == 0.0:
+        return f"{number(law['ideal'], 4)} A^2 ({law['kind']}, held)"
+    return (f"{number(law['coefficient'], 4)} A^2 ({law['kind']}; excess {100.0 * law['excess'] / law['ideal']:+.1f} "
+            f"± {100.0 * law['excess_std'] / abs(law['ideal']):.1f} %, {100.0 * law['learned']:.0f} % learned)")
+
+
+def _halves(halves) -> str:
+    if halves is None:
+        return "too short"
+    return (f"{number(halves['first']['period'], 7)} / {number(halves['second']['period'], 7)} s, "
+            f"z = {halves['z']:+.2f}")
 
 
 class FitSection(Section):

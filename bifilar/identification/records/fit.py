@@ -1,0 +1,1125 @@
+"""The zero-amplitude period of a measured record, cycle by cycle: each cycle's phase, one law for all.
+
+The record is an angle, an angular rate or a signal only proportional to the angle (:mod:`.read`),
+sampled at increasing, possibly uneven times with gaps, with noise (white or correlated over many
+frames), a drifting offset, glitches, stuck values, a tracker locking on, and possibly a second mode
+beating in. The fit never models the damping, the drift or the tracker: it measures each cycle on its
+own and asks one thing of all of them together, the rig's amplitude law.
+
+1. Cycles (:func:`_cycles`): the record is cut into windows one local period long; in each, least
+   squares gives offset + a1 cos(w u) + b1 sin(w u) + a3 cos(3 w u) + b3 sin(3 w u) (u the time from the
+   window's centre, w the local frequency): the fundamental's phase at the centre with its variance,
+   and its amplitude. Over a whole cycle these are orthogonal, so the offset, its drift and the
+   waveform's third harmonic take nothing from the phase. A slow baseline (the offsets, smoothed across
+   cycles) is subtracted before the last pass, so that no window sees a slope.
+2. Left out (:mod:`.clean`): stuck values, single-sample glitches beyond 6 robust sigmas, and whole
+   cycles that are not the rig's (a residual far above the record's typical one: the tracker locking
+   on; too few samples: frames lost; an amplitude that jumps away from its neighbours').
+3. A second mode: a peak of the periodogram of the offsets and residuals, 60 times its median over an
+   octave either side, away from the first mode's harmonics, is fitted as a damped sinusoid jointly with
+   every cycle's own terms (each window's basis projected out), then subtracted and the cycles refitted.
+4. The law (:mod:`.law`): the phases follow Phi(t) = phi0 + omega0 int dt / (R(A(t)) E(A(t))), A(t)
+   the peak amplitude (from the fundamentals through the law's waveform, smoothed across cycles),
+   R the ideal law, E = 1 + ds A^2 + dq A^4 the real rig's excess with Gaussian priors. Weighted least
+   squares gives omega0 = 2 pi / T0, the zero-amplitude period, and the excess.
+5. Uncertainty: the sandwich covariance with the phase residuals' scores summed over blocks of
+   :data:`BLOCK_TAUS` integrated autocorrelation times (tracker noise correlated over many frames, a
+   wandering offset, a left-over beat all make neighbouring cycles err together), never below the
+   white-noise covariance; the prior rows add the law's doubt, reported apart (``period_std_law``).
+
+A proportional record (pixels) has no known scale: with ``scale`` (signal units per rad) it is an
+angle record; with ``max_amplitude`` (rad, the largest swing it can have had) the scale kappa is fitted
+with a prior uniform on [0, max_amplitude / first amplitude]; with neither the law cannot be applied
+(a small swing is assumed, the period is the one at the record's amplitudes) and the fit says so.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.optimize import least_squares
+from scipy.signal import lombscargle
+
+from .clean import OUTLIER_Z, Rejected, spans, stuck
+from .law import EXCESS_PRIOR, LINEAR, AmplitudeLaw, Table
+from .read import KINDS, MIN_SAMPLES
+
+MIN_CYCLES = 3  # cycles measured on their own: fewer, and no phase slope can be told from the law
+MIN_SNR = 3.0  # the fundamental's RMS against the residual's: a noise-only fit reaches ~0.2-0.5
+SECOND_MODE_POWER = 60.0  # peak / local median of the residual periodogram: noise peaks reach ~10-15
+BLOCK_TAUS = 4.0  # batch-means block, in integrated autocorrelation times of the phase residuals
+_WINDOW_SAMPLES = 12  # a window's terms (up to 9 with many samples a cycle) need residual degrees of freedom
+_WINDOW_GAP = 0.35  # largest gap inside a window, in windows: more and its terms are not orthogonal
+_BAD_RMS = 3.0  # a cycle's residual RMS above this times the record's median: not the rig's motion
+_JUMP = math.log(1.5)  # a cycle's amplitude this far (in ln) from its neighbours' median: a jump
+_PHASE_Z = 6.0  # a cycle's phase this many robust sigmas off the law: a slip (left out)
+_PERIODOGRAM_SAMPLES = 1024  # at most this many samples in a periodogram (starting values only)
+_GRID_PER_CYCLE = 8  # integration points of the law's phase integral per cycle (trapezoid, smooth)
+_PASSES = 3  # cycles refitted with the law's local frequency and the baseline removed
+_BASELINE_CYCLES = 3.0  # the baseline: the offsets smoothed over this many cycles either side
+_ENVELOPE_DEGREE = 8  # at most: ln A of a decay to a third of the start over the record needs ~5
+_ENVELOPE_F = 9.0  # one more term of the envelope must lower chi^2 by this times the residual variance
+# The real law's excess E = 1 + ds A^2 + dq A^4 + d6 A^6: a stronger cubic restoring term alone already
+# gives all three (over 0.4..1.25 rad, A^2 and A^4 alone leave 2e-4 of it, enough to bias T0 by 1e-4).
+EXCESS_TERMS = ("ds", "dq", "d6")
+
+
+@dataclass(frozen=True)
+class Law:
+    """What the fit says of the amplitude law: the ideal law's kind and coefficient s (1/rad^2, at
+    the fitted omega0), the excess ds, dq (and their sigmas), the coefficient used, s + ds, and its
+    sigma; ``learned``: how far the record itself determined ds (1: wholly, 0: left at the prior)."""
+
+    kind: str
+    ideal: float | None
+    excess: float
+    excess_std: float
+    quartic: float
+    quartic_std: float
+    learned: float
+    note: str = ""
+
+    @property
+    def coefficient(self) -> float | None:
+        return None if self.ideal is None else self.ideal + self.excess
+
+    def as_dict(self) -> dict:
+        return {"kind": self.kind, "ideal": self.ideal, "coefficient": self.coefficient, "excess": self.excess,
+                "excess_std": self.excess_std, "excess_quartic": self.quartic, "excess_quartic_std": self.quartic_std,
+                "learned": self.learned, "note": self.note}
+
+
+@dataclass(frozen=True)
+class OscillationFit:
+    """A fitted record (module docstring). Times in s, angles in rad (signal units where the scale of a
+    proportional record is unknown).
+
+    ``period`` is T0 = 2 pi / omega0; ``period_std`` its whole standard deviation, the root-sum-square
+    of ``period_std_statistical`` (the record's noise, block sandwich) and ``period_std_law`` (the
+    amplitude law's doubt, from the priors); ``period_std_white`` is the white-noise sigma, for
+    comparison. ``prior_gain`` maps the law's prior errors (in prior sigmas) to T0 (s per sigma):
+    records of one rig share that error (pooling). ``amplitude``: peak rotation in the first and last
+    cycle (None where the scale is unknown). ``cycle_*``: the measured cycles.
+    """
+
+    period: float
+    period_std: float
+    period_std_statistical: float
+    period_std_law: float
+    period_std_white: float
+    prior_gain: np.ndarray
+    law: Law
+    amplitude: tuple[float, float] | None
+    damping: dict
+    offset: float
+    drift: float
+    rms: float
+    outliers: np.ndarray
+    rejected: Rejected
+    second_mode: tuple[float, float, float] | None
+    block: int
+    samples: int
+    cycles: int
+    cycle_time: np.ndarray  # s, centre of each cycle used
+    cycle_period: np.ndarray  # s, between neighbouring cycles (nan where not neighbours)
+    cycle_amplitude: np.ndarray  # rad (or signal units), peak, at each cycle
+    law_curve: tuple[np.ndarray, np.ndarray, np.ndarray]  # amplitude, T(A) fitted, T(A) ideal
+    t: np.ndarray
+    y: np.ndarray
+    fitted: np.ndarray  # the model at every sample time (nan where no cycle covers it)
+    kept: np.ndarray  # boolean mask of the samples used
+
+
+@dataclass
+class _Record:
+    """The samples being fitted and what is known of them."""
+
+    tau: np.ndarray  # s from the first sample
+    y: np.ndarray
+    kind: str
+    usable: np.ndarray  # not stuck, not a glitch
+    step: float  # median sample spacing, s
+
+
+@dataclass
+class _Cycles:
+    """Local fits of one pass: per window, its centre (s), local frequency (rad/s) and decay rate, phase of the
+    fundamental at the centre (rad, wrapped), its variance, the fundamental's amplitude and the
+    offset (signal units), the residual RMS, the sample indices and the terms (for the model)."""
+
+    centre: np.ndarray
+    omega: np.ndarray
+    decay: np.ndarray  # d ln(amplitude) / dt at the centre, 1/s
+    phase: np.ndarray
+    phase_var: np.ndarray
+    fundamental: np.ndarray
+    offset: np.ndarray
+    rms: np.ndarray
+    index: list
+    terms: list
+    good: np.ndarray = field(default=None)
+    reason: list = field(default=None)
+
+
+def fit_oscillation(t, y, kind: str, law: AmplitudeLaw = LINEAR, *, excess_prior: float = EXCESS_PRIOR,
+                    scale: float | None = None, max_amplitude: float | None = None,
+                    second_mode: bool = True) -> OscillationFit:
+    """Fit the module's model to samples ``y`` at increasing times ``t`` (s).
+
+    ``excess_prior``: the prior std of ds / s and dq / s (0: the ideal law exactly). ``scale`` and
+    ``max_amplitude``: what is known of a proportional record's scale (module docstring). Raises
+    ValueError naming what is wrong with a record that cannot be used.
+    """
+    if kind not in KINDS:
+        raise ValueError(f"kind must be one of {KINDS}, got {kind!r}")
+    t, y = np.asarray(t, dtype=float), np.asarray(y, dtype=float)
+    if t.ndim != 1 or t.shape != y.shape or len(t) < MIN_SAMPLES:
+        raise ValueError(f"need two 1-D arrays of equal length >= {MIN_SAMPLES}, got shapes {t.shape} and {y.shape}")
+    if not (np.all(np.isfinite(t)) and np.all(np.isfinite(y)) and np.all(np.diff(t) > 0.0)):
+        raise ValueError("times must increase and every sample be finite")
+    if kind == "proportional" and scale is not None:
+        y, kind = y / scale, "angle"
+    tau = t - t[0]
+    rec = _Record(tau, y, kind, ~stuck(y), float(np.median(np.diff(tau))))
+    rejected = Rejected(stuck=int((~rec.usable).sum()))
+    omega = _rough_frequency(rec)
+    if omega * tau[-1] / (2.0 * math.pi) < MIN_CYCLES:
+        raise ValueError(f"the record holds {omega * tau[-1] / (2.0 * math.pi):.3g} cycles; at least {MIN_CYCLES} "
+                         "are needed")
+    uses_law = law.kind != "linear" and (kind != "proportional" or max_amplitude is not None)
+    model = _Model(law if uses_law else LINEAR, kind, excess_prior if uses_law else 0.0, max_amplitude)
+    baseline = np.zeros(len(y))
+    second = None
+    cyc = _pass(rec, baseline, lambda c: (np.full(len(c), omega), np.zeros(len(c))), second)
+    _check_swing(cyc, law, kind)
+    model.fit(cyc)
+    for _ in range(_PASSES):
+        if second_mode:  # (re-)estimated on the record as it is, under the latest first mode
+            second = _second_mode(rec, cyc, baseline, model)
+        cyc = _pass(rec, baseline, model.local, second)
+        model.fit(cyc)
+        baseline = baseline + _baseline(rec.tau, cyc)  # the offsets left under the last baseline
+    cyc = _pass(rec, baseline, model.local, second)
+    model.fit(cyc, slips=True)
+    whole = _whole(rec, cyc, model, baseline, second)
+    return _result(rec, t, cyc, model, baseline, whole, rejected)
+
+
+class SwingError(ValueError):
+    """A record whose swing (rad, ``swing``) is past what the rig's law can hold (``limit``)."""
+
+    def __init__(self, swing: float, limit: float):
+        super().__init__(f"a swing of {swing:.4g} rad, past the law's {limit:.4g} rad")
+        self.swing, self.limit = swing, limit
+
+
+def _check_swing(cyc: _Cycles, law: AmplitudeLaw, kind: str) -> None:
+    """Raise :class:`SwingError` if the largest fitted cycle swings past the law's limit: an angle in
+    degrees read as rad, a rate in deg/s, the wrong column (the pipeline names which)."""
+    if law.kind == "linear" or kind == "proportional":
+        return
+    fitted = np.isfinite(cyc.fundamental)
+    if not fitted.any():
+        return
+    swing = cyc.fundamental[fitted] / (cyc.omega[fitted] if kind == "rate" else 1.0)
+    largest = float(np.median(np.sort(swing)[-3:]))  # a glitched cycle alone does not refuse a record
+    if largest > law.limit:
+        raise SwingError(largest, law.limit)
+
+
+def _rough_frequency(rec: _Record) -> float:
+    """Angular frequency (rad/s) of the strongest oscillation: the Lomb-Scargle peak of the signal's
+    derivative (of the signal itself for a rate), so that an offset, a slow drift or a tracker's
+    lock-on jumps do not make the peak; differences across gaps and beyond 6 robust sigmas are left out."""
+    keep = rec.usable
+    tau, y = rec.tau[keep], rec.y[keep]
+    if rec.kind == "rate":
+        x, v = tau, y - np.median(y)
+    else:
+        dt = np.diff(tau)
+        ok = dt <= 1.5 * rec.step
+        x, v = 0.5 * (tau[1:] + tau[:-1])[ok], (np.diff(y) / dt)[ok]
+    if len(x) < MIN_SAMPLES:
+        raise ValueError(f"{len(x)} usable samples; at least {MIN_SAMPLES} are needed")
+    # a step (the tracker locking on) is a spike of the derivative, clipped here; the derivative weighs a
+    # mode by its frequency squared, which a second mode beating in (a few percent of the swing, at most a
+    # few times its frequency) does not make up for, while the tracker's red noise and drift fall away
+    dev = np.abs(v - np.median(v))
+    mad = 1.4826 * float(np.median(dev)) or float(dev.max()) or 1.0
+    x, v = x[dev <= OUTLIER_Z * mad], v[dev <= OUTLIER_Z * mad]
+    span = rec.tau[-1]
+    resolution = 2.0 * math.pi / span
+    stride = max(1, -(-len(x) // _PERIODOGRAM_SAMPLES))
+    xs, vs = x[::stride], v[::stride]
+    nyquist = math.pi * (len(xs) - 1) / (xs[-1] - xs[0])
+    grid = np.arange(MIN_CYCLES * resolution, nyquist, 0.5 * resolution)
+    if len(grid) < 3:
+        raise ValueError(f"the record is too short or too sparse to hold {MIN_CYCLES} cycles")
+    power = lombscargle(xs, vs, grid, floating_mean=True)
+    k = int(np.argmax(power))
+    if k == 0 or k == len(grid) - 1:
+        raise ValueError(f"no oscillation peak inside {grid[0]:.4g}..{grid[-1]:.4g} rad/s: fewer than "
+                         f"{MIN_CYCLES} cycles, or undersampled")
+    fine = grid[k] + np.linspace(-0.5, 0.5, 21) * resolution
+    fpower = lombscargle(xs, vs, fine, floating_mean=True)
+    return float(fine[int(np.argmax(fpower))])
+
+
+def _pass(rec: _Record, baseline: np.ndarray, local, second) -> _Cycles:
+    """One pass over the record: windows one local period long, centred a local period apart from the
+    first sample, fitted (:func:`_cycles`) with the local frequency and decay rate ``local(times)``
+    gives, glitches rejected and refitted, bad cycles marked."""
+    y = rec.y - baseline - (second.signal(rec.tau) if second is not None else 0.0)
+    centres = [math.pi / float(local(np.array([0.0]))[0][0])]  # the first window starts at the first sample
+    while True:  # the next centre one local period on
+        w = float(local(np.array([centres[-1]]))[0][0])
+        nxt = centres[-1] + 2.0 * math.pi / w
+        if nxt + 0.5 * math.pi / w > rec.tau[-1]:  # a window needs three quarters of its cycle
+            break
+        centres.append(nxt)
+    centres = np.array(centres)
+    omegas, decays = local(centres)
+    usable = rec.usable.copy()
+    for _ in range(4):
+        cyc = _cycles(rec.tau, y, usable, centres, omegas, decays, rec.kind == "rate")
+        glitch = _glitches(_residuals(rec.tau, y, cyc), usable)
+        if not glitch.any():
+            break
+        usable &= ~glitch
+    cyc.usable = usable
+    _mark(cyc)
+    return cyc
+
+
+def _glitches(r: np.ndarray, usable: np.ndarray) -> np.ndarray:
+    """Single-sample glitches: the residual's step out of line with its usable neighbours,
+    d_i = r_i - (r_prev + r_next) / 2, beyond :data:`OUTLIER_Z` robust sigmas of d and the largest of
+    its neighbours'. A glitch is a spike; what a model leaves of a clean record (a harmonic it does
+    not hold, at a large swing) is smooth, and stays however small the noise."""
+    idx = np.flatnonzero(np.isfinite(r) & usable)
+    glitch = np.zeros(len(r), dtype=bool)
+    if len(idx) < 5:
+        return glitch
+    x = r[idx]
+    d = np.zeros(len(x))
+    d[1:-1] = x[1:-1] - 0.5 * (x[:-2] + x[2:])
+    d[0], d[-1] = x[0] - x[1], x[-1] - x[-2]
+    sigma = 1.4826 * float(np.median(np.abs(d - np.median(d))))
+    big = np.abs(d) > OUTLIER_Z * max(sigma, 1e-300)
+    peak = np.abs(d) >= np.maximum(np.abs(np.roll(d, 1)), np.abs(np.roll(d, -1)))
+    glitch[idx[big & peak]] = True
+    return glitch
+
+
+def _cycles(tau, y, usable, centres, omegas, decays, rate: bool) -> _Cycles:
+    """Least squares in every window (module docstring, step 1); windows without the samples to
+    determine their terms are returned marked, with nan phase."""
+    n = len(centres)
+    out = _Cycles(centres, omegas, decays, np.full(n, np.nan), np.full(n, np.nan), np.full(n, np.nan),
+                  np.full(n, np.nan), np.full(n, np.nan), [None] * n, [None] * n)
+    out.reason = [None] * n
+    out.peak_ratio = np.full(n, np.nan)
+    out.amplitude_var = np.full(n, np.nan)
+    for k, (c, w, lam) in enumerate(zip(centres, omegas, decays)):
+        half = math.pi / w
+        lo, hi = np.searchsorted(tau, [c - half, c + half])
+        idx = np.arange(lo, hi)[usable[lo:hi]]
+        if len(idx) < _WINDOW_SAMPLES:
+            out.reason[k] = "too few samples"
+            continue
+        u = tau[idx] - c
+        edges = np.concatenate([[-half], u, [half]])
+        if np.max(np.diff(edges)) > _WINDOW_GAP * 2.0 * half:
+            out.reason[k] = "frames lost"
+            continue
+        x = _basis(u, w, lam, _harmonics(len(idx)))
+        coef, *_ = np.linalg.lstsq(x, y[idx], rcond=None)
+        r = y[idx] - x @ coef
+        dof = len(idx) - x.shape[1]
+        var = float(r @ r) / dof
+        cov = var * np.linalg.inv(x.T @ x)
+        a1, b1 = coef[1], coef[2]
+        amp2 = a1 * a1 + b1 * b1
+        g = np.array([b1, -a1]) / max(amp2, 1e-300)  # d phase / d (a1, b1), phase = atan2(-b1, a1)
+        phase = math.atan2(-b1, a1)
+        out.phase[k] = phase
+        # the waveform's peak over its fundamental: a symmetric oscillator's odd harmonics all peak at
+        # the turning point, a_n = alpha_n cos(n phi) - beta_n sin(n phi) (for a rate, its n-th harmonic is
+        # n omega a_n)
+        peak = 0.0
+        for j, n in enumerate(range(1, (len(coef) - 1), 2)):
+            an = coef[1 + 2 * j] * math.cos(n * phase) - coef[2 + 2 * j] * math.sin(n * phase)
+            peak += an / (n if rate else 1.0)
+        out.peak_ratio[k] = peak / math.sqrt(amp2)
+        out.phase_var[k] = float(g @ cov[1:3, 1:3] @ g)
+        out.fundamental[k] = math.sqrt(amp2)
+        radial = np.array([a1, b1]) / math.sqrt(max(amp2, 1e-300))
+        out.amplitude_var[k] = float(radial @ cov[1:3, 1:3] @ radial)
+        out.offset[k] = coef[0]
+        out.rms[k] = math.sqrt(var)
+        out.index[k] = idx
+        out.terms[k] = coef
+    return out
+
+
+def _basis(u: np.ndarray, w: float, lam: float, harmonics: int) -> np.ndarray:
+    """Offset, then the odd harmonics 1, 3, .. up to ``harmonics`` (cos, sin pairs) at frequency ``w``,
+    under the envelope e^(lam u) of the amplitude's own decay: a decaying swing fitted with a constant
+    one would shift the centre's phase by ~lam / w, and that shift changes as the decay slows."""
+    env = np.exp(lam * u)
+    cols = [np.ones_like(u)]
+    for n in range(1, harmonics + 1, 2):
+        cols += [env * np.cos(n * w * u), env * np.sin(n * w * u)]
+    return np.column_stack(cols)
+
+
+def _harmonics(samples_per_cycle: float) -> int:
+    """The highest odd harmonic a window can hold: the seventh where a cycle has 24 samples or more,
+    the fifth from 16 (a symmetric oscillator's waveform at 1 rad holds ~1e-2 of third, ~1e-4 of fifth,
+    ~1e-6 of seventh), the third from 8, the fundamental alone below."""
+    return 7 if samples_per_cycle >= 24 else 5 if samples_per_cycle >= 16 else 3 if samples_per_cycle >= 8 else 1
+
+
+def _residuals(tau, y, cyc: _Cycles) -> np.ndarray:
+    """y minus its window's fit at every sample (nan outside fitted windows)."""
+    r = np.full(len(tau), np.nan)
+    for c, w, lam, idx, coef in zip(cyc.centre, cyc.omega, cyc.decay, cyc.index, cyc.terms):
+        if idx is not None:
+            lo, hi = np.searchsorted(tau, [c - math.pi / w, c + math.pi / w])
+            j = np.arange(lo, hi)
+            r[j] = y[j] - _basis(tau[j] - c, w, lam, len(coef) - 2) @ coef
+    return r
+
+
+def _mark(cyc: _Cycles) -> None:
+    """``good``: the windows fitted whose residual and amplitude look like the rest (module docstring,
+    step 2); ``reason`` says why the others are left out."""
+    fitted = np.isfinite(cyc.phase)
+    good = fitted.copy()
+    if fitted.sum() >= MIN_CYCLES:
+        index = np.flatnonzero(fitted)
+        median_rms = float(np.median(cyc.rms[fitted]))
+        for j, k in enumerate(index):
+            # against the record's and its neighbours' (a residual that grows smoothly with the swing, where
+            # a clean record leaves what its harmonics do not hold, is not a tracker's)
+            near = np.delete(cyc.rms[index[max(0, j - 5):j + 6]], min(j, 5))
+            if cyc.rms[k] > _BAD_RMS * max(median_rms, float(np.median(near)) if len(near) else 0.0):
+                good[k] = False
+                cyc.reason[k] = "residual far above the record's (tracker not locked on)"
+        amp = np.log(np.where(good, cyc.fundamental, np.nan))
+        for k in np.flatnonzero(good):
+            near = amp[max(0, k - 3):k + 4]
+            near = near[np.isfinite(near)]
+            if len(near) >= 3 and abs(amp[k] - np.median(near)) > _JUMP:
+                good[k] = False
+                cyc.reason[k] = "amplitude jumps away from its neighbours'"
+    cyc.good = good
+
+
+def _baseline(tau: np.ndarray, cyc: _Cycles) -> np.ndarray:
+    """The slow offset under the oscillation at every sample: the good cycles' offsets smoothed over
+    :data:`_BASELINE_CYCLES` cycles either side (:func:`smooth`), held beyond the ends."""
+    g = cyc.good
+    x = cyc.centre[g]
+    if len(x) < 2:
+        return np.full(len(tau), float(np.median(cyc.offset[g])) if g.any() else 0.0)
+    width = _BASELINE_CYCLES * float(np.median(np.diff(x)))
+    at = np.linspace(x[0], x[-1], max(2, 4 * len(x)))
+    return np.interp(tau, at, smooth(x, cyc.offset[g], at, width))
+
+
+def smooth(x: np.ndarray, y: np.ndarray, at: np.ndarray, width: float, degree: int = 1) -> np.ndarray:
+    """Local polynomial regression (``degree`` 1 or 2) of ``y`` on ``x`` at the points ``at`` with
+    tricube weights over +- ``width``: a running straight line (exact for a linear trend) or parabola
+    (its bias a fourth-order term in width: a decaying amplitude's curvature does not bias it), where
+    too few points are in reach the lower degree."""
+    d = x[None, :] - at[:, None]
+    u = np.abs(d) / width
+    w = np.where(u < 1.0, (1.0 - u**3) ** 3, 0.0)
+    out = np.empty(len(at))
+    for i in range(len(at)):
+        keep = w[i] > 0.0
+        k = min(degree, int(keep.sum()) - 1)
+        if k < 0:
+            out[i] = float(np.interp(at[i], x, y))
+            continue
+        basis = np.vander(d[i, keep] / width, k + 1, increasing=True)
+        sw = np.sqrt(w[i, keep])
+        out[i] = np.linalg.lstsq(basis * sw[:, None], y[keep] * sw, rcond=None)[0][0]
+    return out
+
+
+class _Model:
+    """The phases' law (module docstring, step 4) fitted to the good cycles of a pass.
+
+    The amplitude the law is evaluated at is measured with noise too: it is a smooth envelope fitted to
+    the cycles' amplitudes alone (:class:`_Envelope`), and what its uncertainty does to T0 is added to
+    the covariance (:meth:`_covariance`).
+    """
+
+    def __init__(self, law: AmplitudeLaw, kind: str, prior: float, max_amplitude: float | None):
+        self.law, self.kind, self.prior, self.max_amplitude = law, kind, prior, max_amplitude
+        self.omega0 = None
+        self.table: Table | None = None
+
+    def _table(self, omega: float, largest: float) -> Table:
+        """The law's table at ``omega`` up to ``largest`` rad, recomputed when omega moves by over 1e-6
+        of itself: the exact law's R depends on it through lam omega^2 (d R / d ln omega = eps A^2 / 2
+        < 0.1 for any rig's eps and A < 1.4 rad), so R stays right to 1e-7."""
+        key = getattr(self, "_key", None)
+        if key is None or abs(key[0] / omega - 1.0) > 1e-6 or key[1] < largest:
+            self._key, self._cached = (omega, largest), self.law.table(omega, largest)
+        return self._cached
+
+    def fit(self, cyc: _Cycles, slips: bool = False) -> None:
+        """Fit the good cycles; with ``slips``, cycles whose phase is far off the law are left out
+        (the tracker jumped) and the rest refitted."""
+        good = cyc.good & np.isfinite(cyc.phase)
+        for _ in range(3):
+            if good.sum() < MIN_CYCLES:
+                raise ValueError(f"{int(good.sum())} cycles could be measured on their own; at least "
+                                 f"{MIN_CYCLES} are needed")
+            self._solve(cyc, good)
+            if not slips:
+                break
+            z = self.residual / np.sqrt(self.var)
+            robust = 1.4826 * float(np.median(np.abs(z))) or 1.0
+            slip = np.abs(z) > _PHASE_Z * max(robust, 1.0)
+            if not slip.any():
+                break
+            for k in np.flatnonzero(good)[slip]:
+                cyc.good[k] = False
+                cyc.reason[k] = "phase slips off the law (the tracker jumped)"
+            good = cyc.good & np.isfinite(cyc.phase)
+
+    def _solve(self, cyc: _Cycles, good: np.ndarray) -> None:
+        centre, var = cyc.centre[good], cyc.phase_var[good]
+        n = len(centre)
+        # the cycles' peak amplitudes (signal units; of the angle for a rate) and their ln variances
+        a1 = cyc.fundamental[good] / (cyc.omega[good] if self.kind == "rate" else 1.0)
+        shape = _waveform(a1, cyc.peak_ratio[good])
+        peak_data = a1 * (1.0 + shape[0] * a1**2 + shape[1] * a1**4)
+        log_sd = np.sqrt(cyc.amplitude_var[good]) / cyc.fundamental[good]
+        grid = _phase_grid(centre)
+        envelope = _Envelope(centre, np.log(peak_data), log_sd)
+        b_grid = envelope.basis(grid)
+        amp_grid = np.exp(b_grid @ envelope.beta)
+        omega = float(np.median(cyc.omega[good])) if self.omega0 is None else self.omega0
+        largest = float(amp_grid.max())
+        law_on = self.law.kind != "linear"
+        kappa_max = None
+        if self.kind == "proportional":
+            kappa_max = self.max_amplitude / largest if self.max_amplitude is not None else None
+            largest_rad = self.max_amplitude or 0.0
+        else:
+            largest_rad = largest
+        s = self.law.coefficient(omega)
+        if law_on:
+            self.table = self._table(omega, 1.05 * largest_rad)
+        phase = self._unwrap(cyc, good, grid)
+        names = ["phi", "omega"]
+        start = [0.0, omega]
+        priors = []  # (index, centre, sd)
+        if law_on and self.prior > 0.0:
+            names += list(EXCESS_TERMS)
+            start += [0.0] * len(EXCESS_TERMS)
+            priors += [(2 + j, 0.0, self.prior * abs(s)) for j in range(len(EXCESS_TERMS))]
+        if law_on and kappa_max is not None:
+            names.append("kappa")
+            start.append(0.5 * kappa_max)
+            priors.append((len(names) - 1, 0.5 * kappa_max, kappa_max / math.sqrt(12.0)))
+        ref = float(np.average(centre, weights=1.0 / var))
+        at = np.searchsorted(grid, centre)
+        at_ref = float(np.interp(ref, grid, np.arange(len(grid))))
+        weights = 1.0 / np.sqrt(var)
+        # the damping's own lengthening of the period, second order in it (:func:`damping_shift`)
+        damping = damping_of(grid, amp_grid, omega)
+        slow = 1.0 / (1.0 + damping_shift(damping, amp_grid))
+
+        def terms(p):
+            """(amplitude A(t) in rad on the grid, 1 / (R E D), d(1 / (R E D)) / d ln a, and its
+            derivatives in the law's parameters)."""
+            amp = amp_grid
+            if not law_on:
+                return amp, slow, np.zeros_like(amp), []
+            kappa = p[names.index("kappa")] if "kappa" in names else 1.0
+            a = np.minimum(kappa * amp, self.table.largest)
+            a2 = a * a
+            d = p[2:2 + len(EXCESS_TERMS)] if "ds" in names else np.zeros(len(EXCESS_TERMS))
+            powers = [a2 ** (j + 1) for j in range(len(EXCESS_TERMS))]
+            excess = 1.0 + sum(dj * pw for dj, pw in zip(d, powers))
+            growth = sum(2.0 * (j + 1) * dj * pw for j, (dj, pw) in enumerate(zip(d, powers)))  # a dE/da
+            ratio = self.table.ratio_at(a)
+            g = slow / (ratio * excess)
+            dg_dlna = -g * (self.table.ratio_slope(a) * a / ratio + growth / excess)
+            slopes = [-g * pw / excess for pw in powers] if "ds" in names else []
+            if "kappa" in names:
+                slopes.append(dg_dlna / kappa)
+            return a, g, dg_dlna, slopes
+
+        def integral(f):
+            cum = np.concatenate([np.zeros((1,) + f.shape[1:]),
+                                  np.cumsum(0.5 * (f[1:] + f[:-1]) * np.diff(grid).reshape((-1,) + (1,) * (f.ndim - 1)),
+                                           axis=0)])
+            return cum[at] - _interp_rows(at_ref, cum)
+
+        def evaluate(p):
+            _, g, dg, slopes = terms(p)
+            big = integral(g)
+            r_phase = (phase - p[0] - p[1] * big) * weights
+            cols = [-np.ones(n), -big] + [-p[1] * integral(d) for d in slopes]
+            j_phase = np.column_stack(cols) * weights[:, None]
+            j_envelope = -p[1] * integral(dg[:, None] * b_grid) * weights[:, None]
+            rp = np.array([(p[i] - c) / sd for i, c, sd in priors])
+            jp = np.zeros((len(priors), len(p)))
+            for row, (i, _, sd) in enumerate(priors):
+                jp[row, i] = 1.0 / sd
+            return r_phase, j_phase, j_envelope, rp, jp
+
+        # Gauss-Newton with the analytic Jacobian: phi0 and omega0 enter linearly, the rest nearly so; a
+        # record at one amplitude leaves a direction to the priors alone, which finite differences of a
+        # residual weighted by 1 / sigma_phase would drown in rounding.
+        p = np.array(start, dtype=float)
+        p[0] = float(np.average(phase - omega * integral(terms(p)[1]), weights=weights**2))
+        for _ in range(40):
+            r_phase, j_phase, _, rp, jp = evaluate(p)
+            jac = np.vstack([j_phase, jp])
+            res = np.concatenate([r_phase, rp])
+            col = np.maximum(np.linalg.norm(jac, axis=0), 1e-300)
+            step = -np.linalg.lstsq(jac / col, res, rcond=None)[0] / col
+            new = p + step
+            new[1] = min(max(new[1], 0.5 * omega), 2.0 * omega)
+            if "kappa" in names:
+                new[names.index("kappa")] = max(new[names.index("kappa")], 0.0)
+            done = abs(new[1] - p[1]) <= 1e-14 * p[1] and np.all(np.abs(step[2:]) <= 1e-12 * (1.0 + np.abs(p[2:])))
+            p = new
+            if done:
+                break
+        r_phase, j_phase, j_envelope, rp, jp = evaluate(p)
+        a_fit, g_fit, _, _ = terms(p)
+        self.names, self.params, self.omega0 = names, p, float(p[1])
+        self.residual, self.var = r_phase / weights, var
+        self.ideal = s if law_on else None
+        self.damping = damping
+        self.scale_known = self.kind != "proportional" or "kappa" in names
+        amp_signal = amp_grid
+        slope = envelope.basis(grid, derivative=1) @ envelope.beta
+        self.fund_at = lambda tt: np.interp(tt, grid, amp_signal)
+        self.peak_at = (lambda tt: np.interp(tt, grid, a_fit)) if law_on else (lambda tt: None)
+        self.rate_at = lambda tt: np.interp(tt, grid, g_fit)
+        self.decay_at = lambda tt: np.interp(tt, grid, slope)
+        cum = np.concatenate([[0.0], np.cumsum(0.5 * (g_fit[1:] + g_fit[:-1]) * np.diff(grid))])
+        cum = cum - float(np.interp(at_ref, np.arange(len(grid)), cum))
+        self._phase = (grid, cum, float(p[0]), float(p[1]), float(g_fit[0]), float(g_fit[-1]))
+        self._covariance(j_phase, jp, r_phase, j_envelope, envelope.cov)
+
+    def _unwrap(self, cyc: _Cycles, good: np.ndarray, grid: np.ndarray) -> np.ndarray:
+        """The good cycles' phases made continuous: each one within pi of its predecessor advanced by
+        the local frequency over the time between them."""
+        centre, phase, omega = cyc.centre[good], cyc.phase[good], cyc.omega[good]
+        out = np.empty(len(phase))
+        out[0] = phase[0]
+        for k in range(1, len(phase)):
+            advance = 0.5 * (omega[k] + omega[k - 1]) * (centre[k] - centre[k - 1])
+            predicted = out[k - 1] + advance
+            out[k] = phase[k] + 2.0 * math.pi * round((predicted - phase[k]) / (2.0 * math.pi))
+        return out
+
+    def _covariance(self, jd, jp, r, j_envelope, cov_envelope) -> None:
+        """Module docstring, step 5: white, block sandwich (at least the white one), the priors', and
+        what the envelope's own uncertainty adds (a two-step estimate's correction, Murphy and Topel:
+        H^-1 (J^T J_A) V_A (J_A^T J) H^-1, J_A the phases' response to the envelope's coefficients)."""
+        n, k = jd.shape
+        bread_inv = np.linalg.pinv(jd.T @ jd + jp.T @ jp)
+        white_meat = jd.T @ jd * max(1.0, float(r @ r) / max(n - k, 1))
+        block = _block_length(r)
+        scores = jd * r[:, None]
+        blocks = np.add.reduceat(scores, np.arange(0, n, block), axis=0)
+        nb = len(blocks)
+        sand_meat = blocks.T @ blocks * (nb / max(nb - 1, 1)) * (n / max(n - k, 1))
+        stat_white = bread_inv @ white_meat @ bread_inv
+        stat_sand = bread_inv @ sand_meat @ bread_inv
+        cross = jd.T @ j_envelope
+        envelope = bread_inv @ cross @ cov_envelope @ cross.T @ bread_inv
+        self.block = block
+        self.cov_white = bread_inv @ (jd.T @ jd) @ bread_inv
+        self.cov_stat = (stat_sand if stat_sand[1, 1] > stat_white[1, 1] else stat_white) + envelope
+        self.cov_law = bread_inv @ (jp.T @ jp) @ bread_inv
+        # T0's response to the law's prior being off by one sigma in each of its excess terms (their rows
+        # come first): records of one rig share that error, while a proportional record's scale is its own
+        law_rows = len(EXCESS_TERMS) if "ds" in self.names else 0
+        self.prior_gain = (bread_inv @ jp.T)[1, :law_rows]
+
+    def integral_at(self, tt: np.ndarray) -> np.ndarray:
+        """int dt / (R E D) from the reference time to ``tt`` (s), carried on at the end rates beyond the
+        first and last cycle: the phase is phi0 + omega0 times this."""
+        grid, cum, _, _, g0, g1 = self._phase
+        inside = np.interp(tt, grid, cum)
+        inside = np.where(tt < grid[0], cum[0] + g0 * (tt - grid[0]), inside)
+        return np.where(tt > grid[-1], cum[-1] + g1 * (tt - grid[-1]), inside)
+
+    def phase_at(self, tt: np.ndarray) -> np.ndarray:
+        """The fitted law's phase Phi at times ``tt`` (the cycles' fundamental is A cos Phi)."""
+        _, _, phi, omega, _, _ = self._phase
+        return phi + omega * self.integral_at(tt)
+
+    def law_induced_variance(self) -> float:
+        """The variance of omega0 that the law's parameters carry (their own uncertainty, the record's and
+        the priors'): Sigma_wL Sigma_LL^-1 Sigma_Lw of the whole covariance, the part a fit holding the
+        law at its estimate does not see."""
+        law = [i for i, n in enumerate(self.names) if n in EXCESS_TERMS or n == "kappa"]
+        if not law:
+            return 0.0
+        cov = self.cov_stat + self.cov_law
+        cross = cov[1, law]
+        return float(cross @ np.linalg.pinv(cov[np.ix_(law, law)]) @ cross)
+
+    def local_omega(self, tt: np.ndarray) -> np.ndarray:
+        """The instantaneous frequency (rad/s) the fitted law gives at times ``tt``."""
+        return self.omega0 * self.rate_at(tt)
+
+    def local(self, tt: np.ndarray):
+        """(instantaneous frequency, d ln(amplitude) / dt) at times ``tt``: what the next pass's windows
+        are fitted with."""
+        return self.local_omega(tt), self.decay_at(tt)
+
+
+class _Envelope:
+    """ln A(t) of the cycles' amplitudes as a Chebyshev series in the time scaled to [-1, 1], of the
+    lowest degree past which one more term does not lower chi^2 by :data:`_ENVELOPE_F` times the
+    residual variance (an F test at ~3 sigma), at most :data:`_ENVELOPE_DEGREE`: as smooth as the decay
+    the record shows and no smoother. Fitted to the amplitudes alone: let the phases move it and their
+    noise would pass for a law through it (an error in the regressor attenuates what it regresses).
+    ``cov``: the coefficients' covariance, scaled by chi^2 per degree of freedom where that is above 1."""
+
+    def __init__(self, t: np.ndarray, log_a: np.ndarray, sd: np.ndarray):
+        self.t0, self.t1 = float(t[0]), float(t[-1])
+        n = len(t)
+        best = None
+        for degree in range(0, min(_ENVELOPE_DEGREE, n - 2) + 1):
+            x = self.basis(t, degree=degree) / sd[:, None]
+            beta, *_ = np.linalg.lstsq(x, log_a / sd, rcond=None)
+            r = log_a / sd - x @ beta
+            chi = float(r @ r)
+            dof = max(n - degree - 1, 1)
+            if best is not None and best[2] - chi < _ENVELOPE_F * chi / dof:
+                break
+            best = (degree, beta, chi, dof, x)
+        self.degree, self.beta, chi, dof, x = best
+        self.cov = np.linalg.pinv(x.T @ x) * max(1.0, chi / dof)
+
+    def basis(self, t: np.ndarray, derivative: int = 0, degree: int | None = None) -> np.ndarray:
+        from numpy.polynomial import chebyshev as C
+
+        degree = self.degree if degree is None else degree
+        half = max(0.5 * (self.t1 - self.t0), 1e-300)
+        u = np.clip((np.asarray(t) - 0.5 * (self.t0 + self.t1)) / half, -1.0, 1.0)
+        cols = []
+        for k in range(degree + 1):
+            c = np.zeros(k + 1)
+            c[k] = 1.0
+            cols.append(C.chebval(u, C.chebder(c, derivative) if derivative else c) / half**derivative)
+        return np.column_stack(cols)
+
+
+def _waveform(a1: np.ndarray, peak_ratio: np.ndarray) -> np.ndarray:
+    """(c1, c2) of peak / fundamental = 1 + c1 a1^2 + c2 a1^4, least squares over the cycles: the real
+    rig's waveform, measured on the record (its harmonics are its law's, not the ideal law's: at 1.2 rad
+    they differ by ~excess x 1 %, which moves A by 1e-4 and T0 with it)."""
+    if len(a1) < 3:
+        return np.zeros(2)
+    return np.linalg.lstsq(np.column_stack([a1**2, a1**4]), peak_ratio - 1.0, rcond=None)[0]
+
+
+def _interp_rows(at: float, cum: np.ndarray):
+    """``cum`` (rows on a grid index) interpolated at fractional row ``at``."""
+    i = min(int(at), len(cum) - 2)
+    f = at - i
+    return (1.0 - f) * cum[i] + f * cum[i + 1]
+
+
+def _phase_grid(centre: np.ndarray) -> np.ndarray:
+    """The cycles' centres with :data:`_GRID_PER_CYCLE` - 1 points between neighbours."""
+    parts = [np.linspace(a, b, _GRID_PER_CYCLE, endpoint=False) for a, b in zip(centre[:-1], centre[1:])]
+    return np.concatenate(parts + [centre[-1:]])
+
+
+def _block_length(r: np.ndarray) -> int:
+    """:data:`BLOCK_TAUS` integrated autocorrelation times of ``r`` (initial positive sequence), at most
+    a fifth of the cycles (fewer blocks and their variance is itself too uncertain)."""
+    n = len(r)
+    if n < 10:
+        return 1
+    x = r - r.mean()
+    f = np.fft.rfft(x, 2 * n)
+    acf = np.fft.irfft(f * np.conj(f))[:n]
+    acf = acf / acf[0]
+    below = np.flatnonzero(acf < 0.0)
+    stop = int(below[0]) if len(below) else n
+    tau_int = 1.0 + 2.0 * float(acf[1:stop].sum())
+    return int(min(max(1, math.ceil(BLOCK_TAUS * tau_int)) if tau_int > 1.5 else 1, max(1, n // 5)))
+
+
+def _peak_apart(tau: np.ndarray, rest: np.ndarray, w1: float, chirp: float) -> float | None:
+    """The angular frequency (rad/s) of a periodogram peak of ``rest`` (what the first mode leaves)
+    that stands :data:`SECOND_MODE_POWER` times above the noise floor, within 0.25..4 times the first
+    mode's frequency ``w1`` and apart from it (one resolution 2 pi / span and its ``chirp``) and from its
+    harmonics 2, 3, 4 (what a slightly wrong waveform leaves there); None if none does. The floor is
+    the periodogram's median over an octave either side where the record is long enough to have one
+    (coloured noise included), else white noise's E P = sigma^2 from the differences."""
+    rest = rest - np.polyval(np.polyfit(tau, rest, 1), tau)
+    span = tau[-1] - tau[0]
+    resolution = 2.0 * math.pi / span
+    stride = max(1, -(-len(tau) // _PERIODOGRAM_SAMPLES))
+    x, v = tau[::stride], rest[::stride]
+    grid = np.arange(0.25 * w1, min(4.0 * w1, math.pi * (len(x) - 1) / (x[-1] - x[0])), 0.5 * resolution)
+    if len(grid) < 8:
+        return None
+    near = (np.abs(grid - w1) < resolution + chirp) | (grid < 2.0 * resolution)
+    for k in (2, 3, 4):
+        near |= np.abs(grid - k * w1) < 4.0 * resolution + k * chirp
+    power = np.where(near, 0.0, lombscargle(x, v, grid, floating_mean=True))
+    j = int(np.argmax(power))
+    band = (grid > 0.5 * grid[j]) & (grid < 2.0 * grid[j]) & ~near & (np.abs(grid - grid[j]) > 3.0 * resolution)
+    if band.sum() >= 8:
+        floor = float(np.median(power[band]))
+    else:
+        floor = (1.4826 * float(np.median(np.abs(np.diff(v) - np.median(np.diff(v)))))) ** 2 / 2.0
+    return float(grid[j]) if power[j] >= SECOND_MODE_POWER * floor and j > 0 else None
+
+
+@dataclass(frozen=True)
+class _Second:
+    """A damped sinusoid e^(-decay tau) (c cos + s sin)(omega tau) superposed on the record."""
+
+    omega: float
+    decay: float
+    c: float
+    s: float
+
+    def signal(self, tau):
+        return np.exp(-self.decay * tau) * (self.c * np.cos(self.omega * tau) + self.s * np.sin(self.omega * tau))
+
+
+def _second_mode(rec: _Record, cyc: _Cycles, baseline: np.ndarray, model: _Model) -> _Second | None:
+    """Module docstring, step 3: a mode beating in, from the record minus the first mode as the law
+    fitted it (its phase Phi(t), the cycles' fundamentals between them) and the baseline: a
+    periodogram peak :data:`SECOND_MODE_POWER` times its median over an octave either side, away from
+    the first mode's harmonics, fitted as a damped sinusoid (omega2 and its decay by least squares, its
+    two amplitudes linearly). A mode close to the first in frequency is absorbed by the cycles' own
+    fits, which cannot tell them apart over one cycle, but not by the law's rigid phase: it stands out
+    here and nowhere else. None if nothing stands out."""
+    good = np.flatnonzero(cyc.good & np.isfinite(cyc.phase))
+    if len(good) < MIN_CYCLES:
+        return None
+    idx = np.concatenate([cyc.index[k] for k in good])
+    tau = rec.tau[idx]
+    fundamental = np.interp(tau, cyc.centre[good], cyc.fundamental[good])
+    rest = rec.y[idx] - baseline[idx] - fundamental * np.cos(model.phase_at(tau))
+    rest = rest - np.polyval(np.polyfit(tau, rest, 1), tau)
+    peak = _peak_apart(tau, rest, model.omega0, float(np.ptp(model.local_omega(cyc.centre[good]))))
+    if peak is None:
+        return None
+    span = tau[-1] - tau[0]
+    resolution = 2.0 * math.pi / span
+
+    def fitted(p):
+        """The damped sinusoid (omega2, decay2) fitted to the rest: residual and (cos, sin) amplitudes."""
+        w2, a2 = p
+        z = np.exp(-a2 * tau)[:, None] * np.column_stack([np.cos(w2 * tau), np.sin(w2 * tau)])
+        beta = np.linalg.lstsq(z, rest, rcond=None)[0]
+        return rest - z @ beta, beta
+
+    sol = least_squares(lambda p: fitted(p)[0], [peak, 0.0], bounds=([0.0, 0.0], [np.inf, np.inf]),
+                        x_scale=[resolution, 1.0 / span], xtol=1e-10)
+    c2, s2 = fitted(sol.x)[1]
+    return _Second(float(sol.x[0]), float(sol.x[1]), float(c2), float(s2))
+
+
+@dataclass
+class _Whole:
+    """The whole record fitted at once, the law held (:func:`_whole`): omega0 (rad/s) and its
+    statistical variance, the batch block (cycles), the refined second mode, the model at the samples
+    used and their indices."""
+
+    omega0: float
+    variance: float
+    variance_white: float
+    block: int
+    second: _Second | None
+    fitted: np.ndarray
+    index: np.ndarray
+
+
+def _whole(rec: _Record, cyc: _Cycles, model: _Model, baseline: np.ndarray, second: _Second | None) -> _Whole:
+    """Every sample of the good cycles fitted at once, with the law's shape held as the cycles gave it:
+
+        y - baseline = c0 + c1 u + E(t) [cos Phi + sum_{n=3,5} (E / E_mean)^(n-1) (a_n cos n Phi + b_n sin n Phi)]
+                       + e^(-a2 tau) (c2 cos w2 tau + s2 sin w2 tau),
+        Phi = phi0 + omega0 int dt / (R E D),   E(t) = e^(e0 + e1 u) A_cycles(t),
+
+    u the time from the middle over the span, A_cycles the amplitude the cycles measured (times the
+    local frequency for a rate). A cycle measured alone spends some of its information on its own
+    offset, envelope and harmonics, and a record of a few cycles gives only a few phases; here one
+    phase law, one envelope and one second mode take all of it, the efficiency of a plain damped-sine
+    least squares, while the law's chirp (from the cycles) keeps it right at large amplitude. The
+    phase law's parameters other than phi0 and omega0 stay as the cycles fitted them; what their
+    uncertainty does to omega0 is added after (:meth:`_Model.law_induced_variance`).
+
+    Its uncertainty: the sandwich with the scores summed over each cycle, then over blocks of
+    :data:`BLOCK_TAUS` integrated autocorrelation times of the omega0 score's cycle series, never
+    below the white-noise covariance (residual variance times (J^T J)^-1).
+
+    The samples: those of the good cycles, and the record's usable tail past the last of them (too
+    short a cycle to measure alone, not too short to hold phase). A second mode the cycles did not
+    show is looked for in this fit's own residual (:func:`_peak_apart`), and the fit repeated with it."""
+    good = np.flatnonzero(cyc.good & np.isfinite(cyc.phase))
+    idx = np.unique(np.concatenate([cyc.index[k] for k in good]))
+    tail = np.flatnonzero(cyc.usable & (rec.tau > rec.tau[idx[-1]]))
+    idx = np.concatenate([idx, tail])
+    tau = rec.tau[idx]
+    y = rec.y[idx] - baseline[idx]
+    span = max(tau[-1] - tau[0], 1e-300)
+    u = (tau - 0.5 * (tau[0] + tau[-1])) / span
+    integral = model.integral_at(tau)
+    envelope = model.fund_at(tau) * (model.local_omega(tau) if rec.kind == "rate" else 1.0)
+    level = float(np.exp(np.mean(np.log(envelope))))
+    harmonics = _harmonics(float(np.median([len(cyc.index[k]) for k in good])))
+    _, _, phi0, omega0, _, _ = model._phase
+    first = [phi0, omega0, math.log(float(np.median(cyc.fundamental[good])) / level), 0.0]
+    fit = _whole_fit(tau, y, u, integral, envelope, level, harmonics, first, second)
+    if second is None:
+        chirp = float(np.ptp(model.local_omega(cyc.centre[good])))
+        peak = _peak_apart(tau, fit[2], fit[0][1], chirp)
+        if peak is not None:
+            fit = _whole_fit(tau, y, u, integral, envelope, level, harmonics, list(fit[0][:4]),
+                             _Second(peak, 0.0, 0.0, 0.0))
+            second = _Second(peak, 0.0, 0.0, 0.0)
+    q, jac, r, beta, model_y = fit
+    n, k = jac.shape
+    bread = np.linalg.pinv(jac.T @ jac)
+    white = bread * float(r @ r) / max(n - k, 1)
+    cycle = np.floor((q[1] * (integral - integral[0])) / (2.0 * math.pi)).astype(int)
+    scores = np.zeros((cycle.max() + 1, k))
+    np.add.at(scores, cycle, jac * r[:, None])
+    block = _block_length(scores[:, 1]) if len(scores) >= 10 else 1
+    blocks = np.add.reduceat(scores, np.arange(0, len(scores), block), axis=0)
+    nb = len(blocks)
+    sandwich = bread @ (blocks.T @ blocks) @ bread * (nb / max(nb - 1, 1)) * (n / max(n - k, 1))
+    refined = None
+    if second is not None:
+        c2, s2 = beta[-2:]
+        refined = _Second(float(q[4]), float(q[5]), float(c2), float(s2))
+    return _Whole(float(q[1]), float(max(white[1, 1], sandwich[1, 1])), float(white[1, 1]), int(block), refined,
+                  model_y + baseline[idx], idx)
+
+
+def _whole_fit(tau, y, u, integral, envelope, level, harmonics, first, second):
+    """The least squares of :func:`_whole` from ``first`` (phi0, omega0, e0, e1) and a second mode's
+    (omega2, decay2) start if any: (parameters, Jacobian of the residual with the linear terms last,
+    residual, linear terms, model)."""
+    start = list(first)
+    omega0 = start[1]
+    if second is not None:
+        start += [second.omega, second.decay]
+
+    def design(q):
+        phase = q[0] + q[1] * integral
+        env = np.exp(q[2] + q[3] * u) * envelope
+        cols = [np.ones_like(u), u]
+        for n in range(3, harmonics + 1, 2):
+            rel = env * (env / level) ** (n - 1)
+            cols += [rel * np.cos(n * phase), rel * np.sin(n * phase)]
+        if second is not None:
+            decay = np.exp(-q[5] * tau)
+            cols += [decay * np.cos(q[4] * tau), decay * np.sin(q[4] * tau)]
+        return env * np.cos(phase), np.column_stack(cols)
+
+    def residual(q):
+        fixed, x = design(q)
+        beta = np.linalg.lstsq(x, y - fixed, rcond=None)[0]
+        return y - fixed - x @ beta
+
+    lo = np.full(len(start), -np.inf)
+    hi = np.full(len(start), np.inf)
+    lo[1], hi[1] = 0.9 * omega0, 1.1 * omega0
+    if second is not None:
+        lo[5] = 0.0
+    start = np.clip(np.array(start, dtype=float), lo, hi)
+    sol = least_squares(residual, start, bounds=(lo, hi), x_scale="jac", xtol=1e-12, ftol=1e-12, gtol=1e-12)
+    q = sol.x
+    fixed, x = design(q)
+    beta = np.linalg.lstsq(x, y - fixed, rcond=None)[0]
+    model_y = fixed + x @ beta
+    return q, np.column_stack([sol.jac, -x]), y - model_y, beta, model_y
+
+
+def _result(rec: _Record, t: np.ndarray, cyc: _Cycles, model: _Model, baseline: np.ndarray, whole: _Whole,
+            rejected: Rejected) -> OscillationFit:
+    good = cyc.good & np.isfinite(cyc.phase)
+    omega0 = whole.omega0
+    period = 2.0 * math.pi / omega0
+    to_period = 2.0 * math.pi / omega0**2
+    # the whole record's statistical variance, and what the law's parameters add to it; the law's prior
+    # part of that is reported apart (and is what records of one rig share)
+    std_law = to_period * math.sqrt(model.cov_law[1, 1])
+    std_all = to_period * math.sqrt(whole.variance + model.law_induced_variance())
+    std_stat = math.sqrt(max(std_all**2 - std_law**2, to_period**2 * whole.variance))
+    std_white = to_period * math.sqrt(whole.variance_white)
+    second = whole.second
+    fitted = np.full(len(t), np.nan)
+    kept = np.zeros(len(t), dtype=bool)
+    fitted[whole.index] = whole.fitted
+    kept[whole.index] = True
+    swing = np.sqrt(0.5) * np.median(cyc.fundamental[good])
+    r = (rec.y - fitted)[kept]
+    rms = math.sqrt(float(np.mean(r**2)))
+    if swing / max(rms, 1e-300) < MIN_SNR:
+        raise ValueError(f"no oscillation stands out of the noise (fundamental RMS / residual RMS = "
+                         f"{swing / max(rms, 1e-300):.2g} < {MIN_SNR:g})")
+    # what was left out
+    in_window = np.zeros(len(t), dtype=bool)
+    bad_cycles = []
+    for k in range(len(cyc.centre)):
+        half = math.pi / cyc.omega[k]
+        lo, hi = np.searchsorted(rec.tau, [cyc.centre[k] - half, cyc.centre[k] + half])
+        if good[k]:
+            in_window[lo:hi] = True
+        else:
+            bad_cycles.append((k, lo, hi))
+    glitch = in_window & rec.usable & ~cyc.usable
+    rejected.glitches = int(glitch.sum())
+    out_cycles = np.zeros(len(t), dtype=bool)
+    for k, lo, hi in bad_cycles:
+        seg = np.arange(lo, hi)
+        seg = seg[~in_window[seg] & rec.usable[seg]]
+        out_cycles[seg] = True
+        if len(seg) and cyc.reason[k]:
+            rejected.reasons.append(f"{t[seg[0]]:.6g}..{t[seg[-1]]:.6g} s: {cyc.reason[k]}")
+    # samples past the last whole window are not a cycle: they are not counted as left out
+    rejected.cycles = int(out_cycles.sum())
+    rejected.spans = spans(t, out_cycles | glitch | ~rec.usable, 3.0 * rec.step)
+    # the cycles, for plots and the law's report
+    centre = cyc.centre[good]
+    fund = model.fund_at(centre)
+    amplitude_rad = model.peak_at(centre) if model.law.kind != "linear" else None
+    if model.kind in ("angle", "rate") and model.law.kind == "linear":
+        amplitude_rad = fund  # a linear law: the fundamental is the peak
+    unwrapped = model._unwrap(cyc, good, centre)
+    neighbours = np.diff(np.flatnonzero(good)) == 1
+    per_cycle = np.where(neighbours, 2.0 * math.pi * np.diff(centre) / np.maximum(np.diff(unwrapped), 1e-300), np.nan)
+    cycle_amp = amplitude_rad if amplitude_rad is not None else fund
+    names = model.names
+    std = np.sqrt(np.diag(model.cov_stat + model.cov_law))
+    excess = model.params[names.index("ds")] if "ds" in names else 0.0
+    quartic = model.params[names.index("dq")] if "dq" in names else 0.0
+    learned = 0.0
+    if "ds" in names:
+        i = names.index("ds")
+        prior_sd = model.prior * abs(model.ideal)
+        learned = max(0.0, 1.0 - std[i] ** 2 / prior_sd**2) if prior_sd > 0 else 0.0
+    note = ""
+    if model.kind == "proportional" and "kappa" not in names:
+        note = ("scale unknown: the ideal law cannot be applied; T0 is the period at the record's amplitudes "
+                "(a small swing assumed)")
+    law = Law(model.law.kind if model.law.kind != "linear" or model.kind != "proportional" else "none (scale unknown)",
+              model.ideal, float(excess), float(std[names.index("ds")]) if "ds" in names else 0.0,
+              float(quartic), float(std[names.index("dq")]) if "dq" in names else 0.0, float(learned), note)
+    curve = _law_curve(model, period, cycle_amp)
+    level = cyc.offset[good] + np.interp(centre, rec.tau, baseline)  # the offset under each cycle
+    amplitude = None
+    if model.scale_known and amplitude_rad is not None:
+        amplitude = (float(amplitude_rad[0]), float(amplitude_rad[-1]))
+    return OscillationFit(
+        period=period, period_std=math.hypot(std_stat, std_law), period_std_statistical=std_stat,
+        period_std_law=std_law, period_std_white=std_white, prior_gain=to_period * model.prior_gain, law=law,
+        amplitude=amplitude, damping=model.damping, offset=float(np.median(cyc.offset[good])),
+        drift=float(np.polyfit(centre, cyc.offset[good] + np.interp(centre, rec.tau, baseline), 1)[0])
+        if len(centre) > 1 else 0.0,
+        rms=rms, outliers=t[glitch], rejected=rejected,
+        second_mode=None if second is None else (2.0 * math.pi / second.omega, math.hypot(second.c, second.s),
+                                                 second.decay),
+        block=whole.block, samples=int(kept.sum()), cycles=int(good.sum()), cycle_time=t[0] + centre,
+        cycle_period=per_cycle, cycle_amplitude=cycle_amp, law_curve=curve, t=t, y=rec.y, fitted=fitted, kept=kept)
+
+
+def _law_curve(model: _Model, period: float, amplitude: np.ndarray):
+    """(A, T(A) fitted, T(A) ideal) over the record's amplitude range, for plots."""
+    a = np.linspace(0.0, float(np.max(amplitude)) * 1.05, 60)
+    if model.law.kind == "linear" or model.table is None or not model.scale_known:
+        flat = np.full(len(a), period)
+        return a, flat, flat
+    names, p = model.names, model.params
+    kappa = p[names.index("kappa")] if "kappa" in names else 1.0
+    a_rad = a * kappa if model.kind == "proportional" else a
+    ideal = period * model.table.ratio_at(np.minimum(a_rad, model.table.largest))
+    excess = 1.0
+    if "ds" in names:
+        excess = 1.0 + sum(p[names.index(n)] * a_rad ** (2 * (j + 1)) for j, n in enumerate(EXCESS_TERMS))
+    return a, ideal * excess, ideal
+
+
+def damping_of(time: np.ndarray, amplitude: np.ndarray, omega: float) -> dict:
+    """The decay of the amplitude described by linear, quadratic and dry damping, dA/dt = -zeta omega A
+    - (4 / 3 pi) c omega A^2 - (2 / pi) mu / omega (first-order averaging of theta'' + omega^2 theta =
+    -2 zeta omega theta' - c |theta'| theta' - mu sign theta'), non-negative least squares on A(t) at
+    ``time``: the description the period's damping correction needs (:func:`damping_shift`)."""
+    from scipy.optimize import nnls
+
+    if len(time) < 4:
+        return {"linear": 0.0, "quadratic": 0.0, "dry": 0.0}
+    a = np.asarray(amplitude, dtype=float)
+    slope = np.gradient(a, time)
+    x = np.column_stack([omega * a, 4.0 / (3.0 * math.pi) * omega * a * a, 2.0 / (math.pi * omega) * np.ones_like(a)])
+    coef, _ = nnls(x, -slope)
+    return {"linear": float(coef[0]), "quadratic": float(coef[1]), "dry": float(coef[2] / omega**2)}
+
+
+def damping_shift(damping: dict, amplitude: np.ndarray) -> np.ndarray:
+    """T_damped / T_undamped - 1 of a cycle at each ``amplitude``, for the damping of
+    :func:`damping_of` (``dry`` there is mu / omega^2, in the amplitude's unit).
+
+    Damping lengthens the period at second order in itself, by a form that depends on the damping's
+    kind: zeta^2 / 2 for linear damping, ~0.15 zeta_eff^2 for quadratic, ~1.5 zeta_eff^2 for dry
+    friction (zeta_eff the decrement per radian), ~1e-5 of the period for a hardly damped video record
+    released at 1 rad, as large as its statistical sigma. So it is measured: one and a half cycles of
+    theta'' + theta = -2 zeta theta' - c |theta'| theta' - m tanh(theta' / eps) from each amplitude (a
+    grid, RK4 at 256 steps per cycle: the shift to ~1e-3 of itself), the period from descending
+    crossing to descending crossing, and the amplitude half way (the trough) it belongs to."""
+    zeta, quad, dry = damping["linear"], damping["quadratic"], damping["dry"]
+    amplitude = np.asarray(amplitude, dtype=float)
+    if zeta == quad == dry == 0.0 or not len(amplitude):
+        return np.zeros_like(amplitude)
+    top = float(amplitude.max())
+    a = np.linspace(0.5 * float(amplitude.min()), 1.05 * top, 16)
+    eps = 1e-4 * top
+
+    def acc(th, v):
+        return -th - 2.0 * zeta * v - quad * np.abs(v) * v - dry * np.tanh(v / eps)
+
+    h = 2.0 * math.pi / 256
+    th, v = a.copy(), np.zeros_like(a)
+    crossings = [np.full(len(a), np.nan), np.full(len(a), np.nan)]
+    trough = np.zeros(len(a))
+    for n in range(int(3.0 * 256)):
+        k1v, k1x = acc(th, v), v
+        k2v, k2x = acc(th + 0.5 * h * k1x, v + 0.5 * h * k1v), v + 0.5 * h * k1v
+        k3v, k3x = acc(th + 0.5 * h * k2x, v + 0.5 * h * k2v), v + 0.5 * h * k2v
+        k4v, k4x = acc(th + h * k3x, v + h * k3v), v + h * k3v
+        new = th + h / 6.0 * (k1x + 2 * k2x + 2 * k3x + k4x)
+        new_v = v + h / 6.0 * (k1v + 2 * k2v + 2 * k3v + k4v)
+        down = (th > 0.0) & (new <= 0.0)
+        at = n * h + h * th / np.where(down, th - new, 1.0)
+        first = np.isnan(crossings[0])
+        crossings[1] = np.where(down & ~first & np.isnan(crossings[1]), at, crossings[1])
+        crossings[0] = np.where(down & first, at, crossings[0])
+        trough = np.maximum(trough, np.where(np.isnan(crossings[1]) & ~first, -new, 0.0))
+        th, v = new, new_v
+    shift = (crossings[1] - crossings[0]) / (2.0 * math.pi) - 1.0
+    ok = np.isfinite(shift) & (trough > 0.0)
+    if ok.sum() < 2:
+        return np.zeros_like(amplitude)
+    order = np.argsort(trough[ok])
+    return np.interp(amplitude, trough[ok][order], shift[ok][order])

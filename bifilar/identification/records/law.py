@@ -1,0 +1,236 @@
+"""The amplitude law of a rig: how its period grows with the swing, ideal and as a real rig shows it.
+
+A free oscillation of amplitude A (the peak rotation, rad) has the period T(A) = T0 R(A), T0 the
+small-amplitude period that the inversion needs. The fit of a record (:mod:`.fit`) measures the period
+at the record's amplitudes; this module says how to take it to A = 0.
+
+The ideal law R(A) is the rig's own (:class:`AmplitudeLaw`):
+
+* ``exact``: the exact 1-DOF torsion of :mod:`bifilar.motion.lagrange` (wires of any spacing, the vertical
+  kinetic energy kept), (I + m z'^2) theta'' + m z' z'' theta'^2 + m g z' = 0, divided by I: with
+  z' = (bD / 4H) u(theta), u = sin(theta) / r, r = sqrt(1 - rho sin^2(theta/2)), rho = bD / H^2,
+
+      theta'' = -omega^2 u (1 + lam v theta'^2) / (1 + lam omega^2 u^2),   v = cos(theta) / r + rho u^2 / (4 r),
+
+  lam = bD / (4 H g): m z'^2 / I = lam omega^2 u^2, so the law needs the geometry only, not the mass or
+  the moment; omega is the small-amplitude frequency.
+* ``series``: theta'' = -omega^2 theta (1 + kappa theta^2 + q theta^4), kappa = -8 s / 3 reproducing the
+  Kane model's T(A) = T0 (1 + s A^2) (:func:`bifilar.identification.identify.amplitude_coefficient`), for
+  modes that are not a symmetric torsion; the quintic q (:meth:`AmplitudeLaw.matched`) makes it equal
+  the Kane model's T(A) / T0 at the record's largest amplitude too.
+* ``linear``: R = 1.
+
+A real rig's law is not the ideal one: hook pivots, wire bending and stretch, the air change it by tens
+of percent (up to 30-40 % in the A^2 coefficient on published records). The fit therefore learns the
+excess from the record's own cycle-by-cycle T(A):
+
+    T(A) = T0 R(A) (1 + ds A^2 + dq A^4),
+
+ds and dq with Gaussian priors of standard deviation :data:`EXCESS_PRIOR` times the ideal s (dq per
+rad^2): a record that decays over a wide range of amplitudes determines them, a record at one amplitude
+leaves them at the prior, whose width then enters T0's sigma as the law's doubt (never hidden: the
+report gives it apart, ``period_std_law``).
+
+R comes from one vectorised RK4 quarter cycle per amplitude of a grid (:meth:`AmplitudeLaw.table`),
+the quarter-wave symmetry of an undamped, symmetric oscillator giving the whole period.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, replace
+
+import numpy as np
+from scipy.interpolate import CubicSpline
+
+from bifilar.rig import Rig, RigError
+
+EXCESS_PRIOR = 0.35  # prior std of ds / s (and of dq / s, per rad^2): real rigs differ by up to 30-40 %
+_STEPS = 1024  # RK4 steps per linear period: R to ~1e-10 (the error goes as (omega h)^4)
+_GRID = 24  # amplitudes of a table on (0, A_max], dense near both ends: a cubic spline in A^2 to ~1e-9
+# Matching a series law's quintic to the Kane model's T(A) / T0: the ratio itself is integrated to
+# ~1e-10, the Kane ratio is timed to ~1e-9; 1e-9 and a few secant steps.
+_MATCH_TOL = 1e-9
+_MATCH_STEPS = 6
+# Below this amplitude (rad) the series law's O(A^4) error, ~s^2 A^4, is under 1e-6: no quintic.
+_MATCH_FROM = 0.1
+_LAW_RTOL = 1e-3  # a series law this close to the one fitted with does not change the fit
+
+
+class Table:
+    """R(A) = T(A) / T0 on an amplitude grid (rad), interpolated by a cubic spline in A^2 (R is an even,
+    analytic function of A; R(0) = 1 is the first knot)."""
+
+    def __init__(self, amplitude: np.ndarray, ratio: np.ndarray):
+        self.amplitude, self.ratio = amplitude, ratio
+        self._ratio = CubicSpline(np.concatenate([[0.0], amplitude**2]), np.concatenate([[1.0], ratio]))
+
+    @property
+    def largest(self) -> float:
+        return float(self.amplitude[-1])
+
+    def ratio_at(self, a):
+        """R at peak amplitudes ``a`` (rad), at most :attr:`largest`."""
+        return self._ratio(np.asarray(a) ** 2)
+
+    def ratio_slope(self, a):
+        """dR / dA at peak amplitudes ``a`` (rad): 2 A S'(A^2) of the spline S."""
+        a = np.asarray(a)
+        return 2.0 * a * self._ratio(a**2, 1)
+
+
+@dataclass(frozen=True)
+class AmplitudeLaw:
+    """The restoring law of the module docstring: ``kind`` ``exact``, ``series`` or ``linear``.
+
+    ``rho`` = bD / H^2 and ``lam`` = bD / (4 H g) (s^2) for ``exact``; ``s`` (1/rad^2) and ``quintic``
+    (the theta^5 coefficient of the restoring term, 1/rad^4) for ``series``.
+    """
+
+    kind: str = "linear"
+    rho: float = 0.0
+    lam: float = 0.0
+    s: float = 0.0
+    quintic: float = 0.0
+
+    @classmethod
+    def torsion(cls, torsion_rig) -> "AmplitudeLaw":
+        """The exact law of a :class:`bifilar.motion.lagrange.TorsionRig`."""
+        bd, h = torsion_rig.hook_span * torsion_rig.attach_span, torsion_rig.height
+        return cls("exact", rho=bd / h**2, lam=bd / (4.0 * h * torsion_rig.gravity))
+
+    @property
+    def limit(self) -> float:
+        """The largest amplitude (rad) the law holds to: where the exact torsion's wires turn
+        horizontal (or pi, where they would cross), pi / 2 for a swing (the body at the hooks' height)."""
+        if self.kind == "exact":
+            return math.pi if self.rho <= 1.0 else 2.0 * math.asin(math.sqrt(1.0 / self.rho))
+        return 0.5 * math.pi
+
+    def coefficient(self, omega: float) -> float:
+        """s in T(A) = T0 (1 + s A^2 + O(A^4)) (1/rad^2) at zero-amplitude frequency ``omega``.
+
+        Exact law: s = eps / 4 - 3 beta / 8 with eps = lam omega^2 and beta = -1/6 + rho / 8, the series
+        of :func:`bifilar.motion.lagrange.period_amplitude_coefficient`."""
+        if self.kind == "exact":
+            return 0.25 * self.lam * omega**2 - 0.375 * (-1.0 / 6.0 + 0.125 * self.rho)
+        return self.s
+
+    def acceleration(self, theta, rate, omega: float):
+        """theta'' of the undamped law (numpy, elementwise)."""
+        w2 = omega * omega
+        if self.kind == "exact":
+            half, co = np.sin(0.5 * theta), np.cos(0.5 * theta)
+            r = np.sqrt(np.maximum(1.0 - self.rho * half * half, 1e-12))
+            u = 2.0 * half * co / r  # sin(theta) / r
+            v = (1.0 - 2.0 * half * half) / r + 0.25 * self.rho * u * u / r  # cos(theta) / r + ...
+            return -w2 * u * (1.0 + self.lam * v * rate * rate) / (1.0 + self.lam * w2 * u * u)
+        if self.kind == "series":
+            t2 = theta * theta
+            return -w2 * theta * (1.0 + (-8.0 / 3.0) * self.s * t2 + self.quintic * t2 * t2)
+        return -w2 * theta
+
+    def table(self, omega: float, largest: float) -> Table:
+        """R(A) on :data:`_GRID` amplitudes up to ``largest`` (rad, clipped to 0.98 of :attr:`limit`):
+        a quarter cycle from rest at each, by RK4, the zero crossing by the step's cubic Hermite."""
+        top = min(max(largest, 1e-3), 0.98 * self.limit)
+        k = np.arange(_GRID)
+        amps = top * np.sin(0.5 * math.pi * (k + 1) / _GRID)  # dense near both ends
+        if self.kind == "linear":
+            return Table(amps, np.ones(_GRID))
+        period = 2.0 * math.pi / omega
+        h = period / _STEPS
+        theta, rate = amps.copy(), np.zeros(_GRID)
+        acc = self.acceleration(theta, rate, omega)
+        quarter = np.full(_GRID, np.nan)
+        n = 0
+        while np.isnan(quarter).any():
+            if n > 40 * _STEPS:
+                raise RigError("<law>", "amplitude", f"the {self.kind} law does not return within 10 periods")
+            r2 = rate + 0.5 * h * acc
+            a2 = self.acceleration(theta + 0.5 * h * rate, r2, omega)
+            r3 = rate + 0.5 * h * a2
+            a3 = self.acceleration(theta + 0.5 * h * r2, r3, omega)
+            r4 = rate + h * a3
+            a4 = self.acceleration(theta + h * r3, r4, omega)
+            new = theta + h / 6.0 * (rate + 2.0 * r2 + 2.0 * r3 + r4)
+            new_rate = rate + h / 6.0 * (acc + 2.0 * a2 + 2.0 * a3 + a4)
+            new_acc = self.acceleration(new, new_rate, omega)
+            n += 1
+            crossed = np.isnan(quarter) & (new <= 0.0) & (theta > 0.0)
+            for j in np.flatnonzero(crossed):
+                quarter[j] = (n - 1) * h + h * _hermite_root(theta[j], rate[j], new[j], new_rate[j], h)
+            theta, rate, acc = new, new_rate, new_acc
+        return Table(amps, 4.0 * quarter / period)
+
+    def ratio(self, amplitude: float, omega: float) -> float:
+        """T(A) / T0 of the undamped law at ``amplitude`` (rad)."""
+        if self.kind == "linear" or amplitude == 0.0:
+            return 1.0
+        return float(self.table(omega, amplitude).ratio[-1])  # the table's last knot is the amplitude
+
+    def matched(self, amplitude: float, ratio: float, omega: float) -> "AmplitudeLaw":
+        """This series law with the quintic coefficient that makes its T(A) / T0 at ``amplitude``
+        equal ``ratio`` (the Kane model's, :func:`bifilar.identification.identify.amplitude_ratio`):
+        right at O(A^2) by s and at the record's largest amplitude by the quintic. T(A) / T0 falls by
+        ~(5 / 16) q A^4 as q grows, nearly linearly: secant steps from that estimate."""
+        if self.kind != "series":
+            raise ValueError("only a series law takes a quintic term")
+        law = replace(self, quintic=0.0)
+        step = 16.0 / (5.0 * amplitude**4)
+        q0, r0 = 0.0, law.ratio(amplitude, omega)
+        q1 = q0 + (r0 - ratio) * step
+        for _ in range(_MATCH_STEPS):
+            r1 = replace(law, quintic=q1).ratio(amplitude, omega)
+            if abs(r1 - ratio) < _MATCH_TOL or r1 == r0:
+                break
+            q0, r0, q1 = q1, r1, q1 - (r1 - ratio) * (q1 - q0) / (r1 - r0)
+        return replace(law, quintic=float(q1))
+
+    def same_as(self, other: "AmplitudeLaw") -> bool:
+        """Whether a fit with ``other`` would be this fit (a series law moved by under 1e-3)."""
+        if self.kind != "series" or other.kind != "series":
+            return self == other
+        return abs(other.s - self.s) <= _LAW_RTOL * abs(self.s) and other.quintic == self.quintic
+
+
+LINEAR = AmplitudeLaw()
+
+
+def law_for(rig: Rig, axis, amplitude: float | None = None, rest=None) -> AmplitudeLaw:
+    """The rig's own law about ``axis``: the exact 1-DOF torsion for the vertical axis of a symmetric
+    rig, else the Kane model's period-amplitude series at the rig's moment, right at O(A^2); with the
+    record's largest ``amplitude`` (rad) its quintic is matched to the Kane model's T(A) / T0 there
+    (:meth:`AmplitudeLaw.matched`). ``rest``: the rig's rest pose if known (it does not depend on the
+    inertia)."""
+    from bifilar.identification.identify import AXES, amplitude_coefficient, amplitude_ratio, axis_vector, linear_period
+    from bifilar.motion import lagrange
+
+    if np.allclose(axis_vector(axis), AXES["z"]):
+        try:
+            return AmplitudeLaw.torsion(lagrange.from_rig(rig))
+        except RigError:
+            pass  # not a symmetric torsion: the Kane series below
+    law = AmplitudeLaw("series", s=amplitude_coefficient(rig, axis, rest))
+    if amplitude is not None and amplitude > _MATCH_FROM:
+        omega = 2.0 * math.pi / linear_period(rig, axis, rest)
+        law = law.matched(amplitude, amplitude_ratio(rig, axis, amplitude, rest), omega)
+    return law
+
+
+def _hermite_root(x0: float, v0: float, x1: float, v1: float, h: float) -> float:
+    """The root in [0, 1] of the cubic Hermite through (x0, v0 h) and (x1, v1 h) on a unit step, by
+    Newton from the secant (the cubic is monotone there: the law is descending through zero)."""
+    u = x0 / (x0 - x1)
+    for _ in range(8):
+        h00, h10 = (1 + 2 * u) * (1 - u) ** 2, u * (1 - u) ** 2
+        h01, h11 = u * u * (3 - 2 * u), u * u * (u - 1)
+        f = h00 * x0 + h10 * h * v0 + h01 * x1 + h11 * h * v1
+        d00, d10 = 6 * u * u - 6 * u, 3 * u * u - 4 * u + 1
+        d01, d11 = -6 * u * u + 6 * u, 3 * u * u - 2 * u
+        df = d00 * x0 + d10 * h * v0 + d01 * x1 + d11 * h * v1
+        step = f / df
+        u -= step
+        if abs(step) < 1e-15:
+            break
+    return u

@@ -1,0 +1,236 @@
+"""From record files to a moment of inertia: read -> fit -> amplitude law -> refit -> invert -> pool.
+
+:func:`identify_records` is the whole loop, in the order it runs:
+
+1. read each file (:func:`.read.read_record`: delimiter, header, units, lost frames, a folded tracker);
+2. fit it with the rig's ideal amplitude law (:func:`.law.law_for`; :mod:`.fit` measures each cycle's
+   phase and learns the real law's excess from the record's own T(A));
+3. check that the swing the record implies is one the rig can make (an angle in degrees read as
+   radians, a rate in deg/s read as rad/s, the wrong column: refused in one line naming the likely
+   unit, :func:`swing_problem`; the fit checks it on its first cycles, before the law is built);
+4. for a mode that is not a symmetric torsion, the law is the Kane model's series at the identified
+   moment with its quintic matched at the record's amplitude: refit once if it moved;
+5. invert the zero-amplitude period into the moment (:func:`bifilar.identification.identify.invert_period`);
+6. fit each half of the record alone: their agreement is the record's own test of its sigma (``halves``);
+7. pool the trials (:func:`pool`): the records of one rig share its amplitude law, so the part of each
+   sigma that is the law's prior is common to all of them (a full covariance, not independent noise).
+
+A trial's repeatability sigma is its period's alone; the rig's geometry and mass are common to every
+trial and enter once, after pooling (:mod:`bifilar.identification.propagation`).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.stats import chi2
+
+from bifilar.identification.identify import Pencil, invert_period, pencil
+from bifilar.rig import Rig, RigError
+
+from .fit import OscillationFit, SwingError, fit_oscillation
+from .law import EXCESS_PRIOR, AmplitudeLaw, law_for
+from .read import Record, read_record
+
+CONSISTENCY = 0.99  # chi^2 quantile above which the trials are called inconsistent
+HALVES_Z = 3.0  # halves further apart than this many sigmas: flagged
+SUSPECT_TORSION = 0.5 * math.pi  # a torsion beyond this is rare enough to say so (rad)
+_DEGREE = math.pi / 180.0
+
+
+@dataclass(frozen=True)
+class RecordOptions:
+    """How to read and fit the records (identify's record options; units as :mod:`.read` says).
+    ``law_sigma``: the prior std of the real law's excess relative to the ideal coefficient;
+    ``amplitude_scale`` (signal units per rad) and ``max_amplitude`` (rad): what is known of a
+    proportional record's scale."""
+
+    column: str | None = None
+    kind: str = "angle"
+    time_column: str | None = None
+    fps: float | None = None
+    time_unit: str = "s"
+    angle_unit: str = "rad"
+    start: float | None = None
+    end: float | None = None
+    law_sigma: float = EXCESS_PRIOR
+    amplitude_scale: float | None = None
+    max_amplitude: float | None = None
+
+
+@dataclass(frozen=True)
+class Halves:
+    """The record's two halves fitted alone: periods and sigmas (s), the split time (s), and z, their
+    difference in its own sigma (the law's common prior taken out)."""
+
+    first: tuple[float, float]
+    second: tuple[float, float]
+    split: float
+    z: float
+
+
+@dataclass(frozen=True)
+class Trial:
+    """One record: its fit, its halves (None where a half is too short to fit), the moment it gives
+    (kg m^2) and that moment's repeatability sigma (from the period's sigma alone), the sensitivity
+    d ln T / d ln J, and what it flags."""
+
+    record: Record
+    fit: OscillationFit
+    halves: Halves | None
+    moment: float
+    moment_std: float
+    sensitivity: float
+    flags: tuple[str, ...]
+
+
+@dataclass(frozen=True)
+class Pooled:
+    """The trials' pooled period (s) and its sigma (Birge-scaled), chi^2 per degree of freedom (None
+    for one trial), the sample standard deviation of the trials' moments (kg m^2; None for one), and
+    whether the scatter is consistent with the stated sigmas."""
+
+    period: float
+    period_std: float
+    chi2_per_dof: float | None
+    between_trial_std: float | None
+    consistent: bool
+
+
+def identify_records(rig: Rig, axis, paths: list, options: RecordOptions = RecordOptions(),
+                     p: Pencil | None = None) -> tuple[list[Trial], Pooled]:
+    """The module's loop over ``paths`` (record files, or :class:`.read.Record` objects already read) of
+    one rig: the trials and their pool. ``p``: the rig's pencil about ``axis`` (its rest pose), if
+    known. Raises :class:`RigError` naming the file and column of a record that cannot be used."""
+    p = pencil(rig, axis) if p is None else p
+    ideal = law_for(rig, axis, rest=p.lin.rest)
+    trials = []
+    for path in paths:
+        record = path if isinstance(path, Record) else read_record(
+            path, options.column, options.kind, time_column=options.time_column, fps=options.fps,
+            time_unit=options.time_unit, angle_unit=options.angle_unit, start=options.start, end=options.end)
+        fit = _fit(record, ideal, options)
+        law = _law_at(rig, axis, fit, ideal, p)
+        if not law.same_as(ideal):
+            fit = _fit(record, law, options)
+        found = _invert(rig, axis, fit, record, p)
+        split = halves(record, law, options)
+        std = found.moment * fit.period_std / fit.period / found.sensitivity
+        trials.append(Trial(record, fit, split, found.moment, std, found.sensitivity,
+                            tuple(_flags(record, fit, split, options))))
+    return trials, pool(trials)
+
+
+def _fit(record: Record, law: AmplitudeLaw, options: RecordOptions) -> OscillationFit:
+    try:
+        return fit_oscillation(record.t, record.y, record.kind, law, excess_prior=options.law_sigma,
+                               scale=options.amplitude_scale, max_amplitude=options.max_amplitude)
+    except SwingError as exc:
+        raise RigError(record.source, record.column, swing_problem(record, exc.swing, law, options)) from None
+    except ValueError as exc:  # a record the fit cannot use
+        raise RigError(record.source, record.column, str(exc)) from None
+
+
+def _law_at(rig: Rig, axis, fit: OscillationFit, ideal: AmplitudeLaw, p: Pencil) -> AmplitudeLaw:
+    """Step 4: a series law recomputed at the identified moment and matched at the record's largest
+    amplitude; the exact torsion law needs neither."""
+    if ideal.kind != "series":
+        return ideal
+    found = _invert(rig, axis, fit, None, p)
+    return law_for(found.rig, axis, fit.amplitude[0] if fit.amplitude else None, p.lin.rest)
+
+
+def _invert(rig: Rig, axis, fit: OscillationFit, record: Record | None, p: Pencil):
+    try:
+        return invert_period(rig, axis, fit.period, p=p)
+    except RigError as exc:
+        if exc.field != "period" or record is None:
+            raise
+        raise RigError(record.source, record.column, f"fitted period {exc.problem}") from None
+
+
+def swing_problem(record: Record, swing: float, law: AmplitudeLaw, options: RecordOptions) -> str:
+    """Step 3: what is wrong with a record whose swing (rad) is past what the rig can do, naming the
+    unit that would make it possible (a factor pi / 180 away) or the column and kind."""
+    what = "the rate" if record.kind == "rate" else "the angle"
+    past = ("the wires would turn horizontal or cross" if law.kind == "exact" else
+            "the body would rise to the hooks")
+    text = (f"{what} implies a swing of {swing:.4g} rad ({swing / _DEGREE:.4g} deg), past the rig's "
+            f"{law.limit:.4g} rad where {past}")
+    if options.angle_unit == "rad" and swing * _DEGREE <= law.limit:
+        unit = "deg/s" if record.kind == "rate" else "degrees"
+        return text + f": are the values in {unit} (--angle-unit deg)?"
+    return text + f": check --column and --kind (this is column {record.column!r} read as {record.kind})"
+
+
+def halves(record: Record, law: AmplitudeLaw, options: RecordOptions) -> Halves | None:
+    """Step 6: the record cut at the middle of its time span, each half fitted alone; None if a half
+    cannot be fitted (too few cycles)."""
+    t = record.t
+    split = 0.5 * (t[0] + t[-1])
+    fits = []
+    for part in (t < split, t >= split):
+        try:
+            fits.append(fit_oscillation(t[part], record.y[part], record.kind, law, excess_prior=options.law_sigma,
+                                        scale=options.amplitude_scale, max_amplitude=options.max_amplitude))
+        except ValueError:
+            return None
+    a, b = fits
+    common = a.prior_gain - b.prior_gain  # the law's prior moves both: only its difference separates them
+    var = _independent(a) + _independent(b) + float(common @ common)
+    return Halves((a.period, a.period_std), (b.period, b.period_std), float(split),
+                  float((a.period - b.period) / math.sqrt(var)))
+
+
+def _independent(fit: OscillationFit) -> float:
+    """The variance of T0 that is this record's own: all but the law's prior part."""
+    return max(fit.period_std**2 - float(fit.prior_gain @ fit.prior_gain), fit.period_std_statistical**2)
+
+
+def _flags(record: Record, fit: OscillationFit, halves: Halves | None, options: RecordOptions) -> list[str]:
+    name = record.source.rsplit("/", 1)[-1]
+    flags = []
+    if fit.amplitude is not None and record.kind != "proportional" and fit.amplitude[0] > SUSPECT_TORSION:
+        flags.append(f"{name}: a swing of {fit.amplitude[0]:.3g} rad is more than pi/2: check the angle unit")
+    if fit.law.note:
+        flags.append(f"{name}: {fit.law.note}; give --max-amplitude (rad) or --amplitude-scale (units per rad) "
+                     "to correct it")
+    if halves is not None and abs(halves.z) > HALVES_Z:
+        flags.append(f"{name}: its halves disagree by {halves.z:+.2g} sigma (T0 {halves.first[0]:.7g} against "
+                     f"{halves.second[0]:.7g} s): its sigma may not hold")
+    if fit.law.ideal and fit.law.learned > 0.5 and options.law_sigma > 0.0:
+        rel = fit.law.excess / fit.law.ideal
+        if abs(rel) > 3.0 * options.law_sigma:
+            flags.append(f"{name}: its periods follow an amplitude law {rel:+.0%} off the ideal rig's (prior "
+                         f"+-{options.law_sigma:.0%}): check the angle unit, the column and the rig file")
+    if fit.period_std > 0.01 * fit.period:
+        flags.append(f"{name}: T0 is known to {100.0 * fit.period_std / fit.period:.2g} % only")
+    return flags
+
+
+def pool(trials: list[Trial]) -> Pooled:
+    """The generalised least-squares mean of the trials' periods under their full covariance: each
+    record's own variance on the diagonal, and the law's prior part shared by all
+    (C_ij = g_i . g_j, :attr:`OscillationFit.prior_gain`); chi^2 = r^T C^-1 r over n - 1 degrees of
+    freedom. Above 1 per degree of freedom the pooled sigma is scaled by its square root (Birge); above
+    the :data:`CONSISTENCY` quantile the trials are called inconsistent."""
+    t = np.array([tr.fit.period for tr in trials])
+    gains = [tr.fit.prior_gain for tr in trials]
+    width = max(len(g) for g in gains)
+    g = np.array([np.pad(x, (0, width - len(x))) for x in gains]) if width else np.zeros((len(trials), 0))
+    cov = np.diag([_independent(tr.fit) for tr in trials]) + g @ g.T
+    ones = np.ones(len(t))
+    inv = np.linalg.pinv(cov)
+    var = 1.0 / float(ones @ inv @ ones)
+    mean = var * float(ones @ inv @ t)
+    if len(trials) == 1:
+        return Pooled(mean, math.sqrt(var), None, None, True)
+    dof = len(trials) - 1
+    r = t - mean
+    value = float(r @ inv @ r)
+    ratio = value / dof
+    moments = np.array([tr.moment for tr in trials])
+    return Pooled(mean, math.sqrt(var * max(1.0, ratio)), ratio, float(moments.std(ddof=1)),
+                  value <= chi2.ppf(CONSISTENCY, dof))
