@@ -24,6 +24,7 @@ from bifilar.identification.periods import crossing_times
 from bifilar.identification.records import AmplitudeLaw, Record, RecordOptions, fit_oscillation, identify_records
 from bifilar.identification.records import synthetic as Y
 from bifilar.identification.records.pipeline import halves
+from bifilar.identification.records.read import unfold
 from bifilar.motion import lagrange as L
 
 from ..assets import rig
@@ -36,7 +37,10 @@ Z95 = 1.959963984540054
 
 
 def _record(rec: Y.Synthetic, name: str) -> Record:
-    return Record(name, "signal", rec.traits.kind, rec.t, rec.y)
+    """The synthetic record as :func:`.read.read_record` would give it from a file: a folded line
+    tracker's angle unfolded."""
+    y = unfold(rec.y)[0] if rec.traits.kind == "angle" else rec.y
+    return Record(name, "signal", rec.traits.kind, rec.t, y)
 
 
 @case("identify-records", source="issue 18 (real records' traits)", engines=("analytic", "kane"))
@@ -109,16 +113,18 @@ def record_coverage(ctx: CaseContext):
     zs, agree, total = [], 0, 0
     for which, rec, torsion, options in _coverage_records(rng):
         law = AmplitudeLaw.torsion(torsion)
-        fit = fit_oscillation(rec.t, rec.y, rec.traits.kind, law, max_amplitude=options.max_amplitude)
+        fit = fit_oscillation(rec.t, _record(rec, which).y, rec.traits.kind, law, max_amplitude=options.max_amplitude)
         zs.append((fit.period - rec.period) / fit.period_std)
         h = halves(_record(rec, which), law, options)
-        total += 1
-        agree += h is not None and abs(h.z) < 3.0
+        if h is not None:  # a record too short to fit by halves (a few laser cycles) tells nothing here
+            total += 1
+            agree += abs(h.z) < 3.0
     zs = np.array(zs)
     hits = float(np.mean(np.abs(zs) <= Z95))
     n = len(zs)
     return [
-        check("records whose halves agree within 3 sigma", agree / total, 0.90, "issue 18: at least 90 %",
+        check("records whose halves agree within 3 sigma", agree / total, 0.90,
+              f"issue 18: at least 90 % (of the {total} long enough to fit by halves)",
               at_least=True),
         check("coverage of the 95 % interval", hits, 0.90, f"issue 18: 90-98 % ({n} records)", at_least=True),
         check("coverage of the 95 % interval (upper)", hits, 0.98, f"issue 18: 90-98 % ({n} records)"),
@@ -135,8 +141,11 @@ def zero_crossing_period(t: np.ndarray, y: np.ndarray, law: AmplitudeLaw, omega:
     rest = y - np.polyval(np.polyfit(t, y, 1), t)
     times = crossing_times(t, rest, 0.0, rising=False)
     periods = np.diff(times)
-    amps = np.array([np.abs(rest[(t >= a) & (t < b)]).max() * p / (2.0 * math.pi)
-                     for a, b, p in zip(times[:-1], times[1:], periods)])
+    inside = [(t >= a) & (t < b) for a, b in zip(times[:-1], times[1:])]
+    whole = np.array([m.sum() >= 4 for m in inside])  # a spurious crossing pair a frame apart: no cycle
+    periods = periods[whole]
+    amps = np.array([np.abs(rest[m]).max() * p / (2.0 * math.pi)
+                     for m, p in zip((m for m, w in zip(inside, whole) if w), periods)])
     table = law.table(omega, float(amps.max()) * 1.05)
     return float(np.mean(periods / table.ratio_at(amps)))
 
@@ -167,8 +176,10 @@ def record_trials(ctx: CaseContext):
     mean_chi = float(np.mean(chis))
     low, high = chi2.ppf([0.005, 0.995], dof) / dof
     return [
-        check("mean chi^2 per degree of freedom of the pooled trials", abs(mean_chi - 1.0), max(1.0 - low, high - 1.0),
-              f"chi^2 of {dof} degrees of freedom over {dof}: its 99 % range"),
+        check("mean chi^2 per degree of freedom of the pooled trials", mean_chi, low,
+              f"chi^2 of {dof} degrees of freedom over {dof}: its 99 % range, lower end", at_least=True),
+        check("mean chi^2 per degree of freedom of the pooled trials (upper)", mean_chi, high,
+              f"chi^2 of {dof} degrees of freedom over {dof}: its 99 % range, upper end"),
         check("spread of T0 over trials / the zero-crossing period's spread", spread_ours / spread_theirs,
               1.0 + 2.5 / math.sqrt(2.0 * dof), f"no worse; each spread's relative error 1/sqrt(2 x {dof})"),
     ]
