@@ -89,8 +89,9 @@ def _layout(n_wires: int) -> tuple[tuple[str, ...], tuple[str, ...]]:
 def apply(rig: Rig, x: np.ndarray) -> tuple[Rig, float]:
     """The rig and period with the input vector ``x`` (in the order of :func:`inputs`)."""
     wires, j = [], 0
-    for _ in rig.wires:
-        wires.append(Wire(anchor=x[j + 1 : j + 4].copy(), attach=x[j + 4 : j + 7].copy(), length=float(x[j])))
+    for w in rig.wires:  # an elastic wire keeps its axial stiffness: the stretch is in the propagation
+        wires.append(Wire(anchor=x[j + 1 : j + 4].copy(), attach=x[j + 4 : j + 7].copy(), length=float(x[j]),
+                          axial_stiffness=w.axial_stiffness))
         j += 7
     changed = replace(rig, wires=tuple(wires), mass=float(x[j]), com=x[j + 1 : j + 4].copy())
     return changed, float(x[j + 4])

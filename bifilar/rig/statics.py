@@ -19,7 +19,7 @@ world frame). Both engines start from :func:`initial_state`, so that they integr
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from scipy.optimize import least_squares, minimize
@@ -122,7 +122,13 @@ def rest_pose(rig: Rig, guess: Rest | None = None) -> Rest:
 
     Raises :class:`RigError` if no pose holds every wire taut (a wire would have to push) or the
     equilibrium found is not stable.
+
+    Elastic wires (``axial_stiffness``): the lowest minimum of the potential energy, gravity plus the
+    wires' strain energy (:mod:`bifilar.rig.elastic`), from ``guess``, the inextensible rest pose of
+    the same wires where that is determinate, and the starts of the inextensible search.
     """
+    if rig.elastic:
+        return _elastic_rest_pose(rig, guess)
     if guess is not None:
         rest = _polish(rig, guess.com, guess.rotation, guess.tensions)
         if rest is not None and _stable(rig, rest):
@@ -130,6 +136,39 @@ def rest_pose(rig: Rig, guess: Rest | None = None) -> Rest:
             # representative as without a guess.
             return Rest(rest.com, _nearest_on_neutral_axis(rig, rest.com, rest.rotation), rest.tensions)
     return _global_rest_pose(rig)
+
+
+def _elastic_rest_pose(rig: Rig, guess: Rest | None) -> Rest:
+    from bifilar.rig import elastic
+
+    starts = [] if guess is None else [(guess.com, guess.rotation)]
+    if guess is None:
+        rigid = replace(rig, wires=tuple(replace(w, axial_stiffness=None) for w in rig.wires))
+        try:  # the inextensible pose: the elastic one is a stretch away from it
+            rest = _global_rest_pose(rigid)
+            starts.append((rest.com, rest.rotation))
+        except (RigError, np.linalg.LinAlgError):  # e.g. four parallel wires: indeterminate when rigid
+            pass
+        for start in (np.eye(3), _hanging_orientation(rig)):
+            starts.append((_start_com(rig, start), start))
+    com, rotation, tensions = elastic.rest_pose(rig, starts, arms(rig), anchors(rig), rig_scale(rig))
+    slack = np.flatnonzero(tensions <= 0.0)
+    if slack.size:
+        i = int(slack[0])
+        raise RigError(rig.source, f"wire[{i + 1}]", "would be slack at rest (shorter than its unstretched length): "
+                       "the body cannot hang taut on every wire")
+    return Rest(com=com, rotation=rotation, tensions=tensions)
+
+
+def _start_com(rig: Rig, rotation: np.ndarray) -> np.ndarray:
+    """A COM for the body turned by ``rotation``: under the anchors' centroid by the mean wire length,
+    then the shortest shift putting every wire at its length where there is one."""
+    guess = anchors(rig).mean(axis=0) - np.array([0.0, 0.0, lengths(rig).mean()])
+    guess = guess - rotation @ (np.array([w.attach for w in rig.wires]).mean(axis=0) - rig.com)
+    try:
+        return guess + taut_shift(rig, guess, rotation)
+    except (RigError, np.linalg.LinAlgError):  # no taut pose at this orientation: the minimiser finds one
+        return guess
 
 
 def _polish(rig: Rig, com: np.ndarray, rotation: np.ndarray, tensions: np.ndarray) -> Rest | None:
@@ -409,6 +448,8 @@ def initial_state(rig: Rig, rest: Rest | None = None) -> State:
     """The rig's initial state, exactly as the rig file's ``[initial]`` table defines it."""
     rest = rest_pose(rig) if rest is None else rest
     rotation = Rotation.from_rotvec(rig.initial_rotation).as_matrix() @ rest.rotation
+    if rig.elastic:
+        return _elastic_initial_state(rig, rest, rotation)
     try:
         com = rest.com + taut_shift(rig, rest.com, rotation)
     except RigError as exc:
@@ -428,3 +469,19 @@ def initial_state(rig: Rig, rest: Rest | None = None) -> State:
         raise RigError(rig.source, "initial.omega", f"no COM velocity keeps every wire at its length "
                        f"(mismatch {miss:.3g} m/s): this spin stretches a wire")
     return State(com=com, rotation=rotation, velocity=velocity, omega=omega)
+
+
+def _elastic_initial_state(rig: Rig, rest: Rest, rotation: np.ndarray) -> State:
+    """Elastic wires: the body turned about its COM by ``initial.rotation`` and held at that orientation
+    while its COM settles (the minimum of the potential over the COM position, :mod:`bifilar.rig.elastic`),
+    then released with ``initial.omega`` and no COM velocity. A wire may be slack there: it pushes
+    nothing. For stiff wires this tends to the inextensible rig's taut shift where the lowest COM on the
+    wire spheres is also the nearest (a turn about the vertical: a pure rise)."""
+    from bifilar.rig import elastic
+
+    com, _, _, ok = elastic.minimise(rig, rest.com, rotation, arms(rig), anchors(rig), rig_scale(rig),
+                                     fixed_rotation=True)
+    if not ok:
+        raise RigError(rig.source, "initial.rotation", "the body turned this far finds no rest for its COM on the "
+                       "elastic wires")
+    return State(com=com, rotation=rotation, velocity=np.zeros(3), omega=np.asarray(rig.initial_omega, dtype=float))
