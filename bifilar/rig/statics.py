@@ -207,31 +207,51 @@ def _global_rest_pose(rig: Rig) -> Rest:
     orientation that best lays the attachments under their anchors, :func:`_hanging_orientation`),
     from that orientation too. Of the stable equilibria found the lowest (least potential) is the rest
     pose: from a far start SLSQP can settle in a higher, twisted equilibrium (wires crossed) that is
-    stable too. Ties keep the file's orientation's."""
+    stable too. Ties keep the file's orientation's.
+
+    Four or more wires have several taut equilibria far apart more often (a 4-wire body has two
+    directions of freedom, a 6-wire one none: its poses are isolated points), and one start stopped in
+    a local minimum or failed (issue 20). They get :data:`MULTI_STARTS` more starts: the hanging
+    orientation without the COM's row, and that orientation turned by fixed rotations spread over the
+    sphere; a start that fails in any way (no taut pose there, a singular matrix) is skipped, and the
+    error of the first start is raised only if no start succeeds."""
     starts = [np.eye(3)]
     hanging = _hanging_orientation(rig)
     if Rotation.from_matrix(hanging).magnitude() > _FAR_START:
         starts.append(hanging)
+    if len(rig.wires) >= 4:
+        starts.append(_hanging_orientation(rig, with_com=False))
+        turns = Rotation.random(MULTI_STARTS, random_state=_START_SEED).as_matrix()
+        starts += [turn @ hanging for turn in turns]
     found, first_error = [], None
     for start in starts:
         try:
             found.append(_search(rig, start))
         except RigError as exc:
             first_error = first_error or exc
+        except (np.linalg.LinAlgError, ValueError, FloatingPointError) as exc:  # a start gone numerically wrong
+            first_error = first_error or RigError(rig.source, "wire", f"no equilibrium with every wire taut found ({exc})")
     if not found:
         raise first_error
     lowest = min(r.com[2] for r in found)
     return next(r for r in found if r.com[2] <= lowest + 1e-9 * rig_scale(rig))
 
 
-def _hanging_orientation(rig: Rig) -> np.ndarray:
+# Extra rest-pose starts for four or more wires, and the seed of their fixed, reproducible rotations.
+MULTI_STARTS = 12
+_START_SEED = 20
+
+
+def _hanging_orientation(rig: Rig, with_com: bool = True) -> np.ndarray:
     """The rotation (body -> world) that best maps the attachments to points hanging straight under
-    their anchors, each by its wire's length, and the COM under their centroid by its body-frame
-    distance from the attachments' centroid (Kabsch: the SVD of the points' cross-covariance)."""
+    their anchors, each by its wire's length, and (``with_com``) the COM under their centroid by its
+    body-frame distance from the attachments' centroid (Kabsch: the SVD of the points' cross-covariance)."""
     body = np.array([w.attach for w in rig.wires] + [rig.com])
     under = anchors(rig) - np.outer(lengths(rig), [0.0, 0.0, 1.0])
     drop = np.linalg.norm(rig.com - body[:-1].mean(axis=0))
     world = np.vstack([under, under.mean(axis=0) - [0.0, 0.0, drop]])
+    if not with_com:
+        body, world = body[:-1], world[:-1]
     u, _, vt = np.linalg.svd((world - world.mean(axis=0)).T @ (body - body.mean(axis=0)))
     d = np.sign(np.linalg.det(u @ vt)) or 1.0
     return u @ np.diag([1.0, 1.0, d]) @ vt
