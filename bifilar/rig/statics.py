@@ -234,10 +234,14 @@ def _global_rest_pose(rig: Rig) -> Rest:
         starts.append(_hanging_orientation(rig, with_com=False))
         turns = Rotation.random(MULTI_STARTS, random_state=_START_SEED).as_matrix()
         starts += [turn @ hanging for turn in turns]
-    found, first_error = [], None
+    found, first_error, indeterminate = [], None, None
     for start in starts:
         try:
             found.append(_search(rig, start))
+        except Indeterminate as exc:  # the lowest of these, if below every pose found, is the answer
+            if indeterminate is None or exc.height < indeterminate.height:
+                indeterminate = exc
+            first_error = first_error or exc
         except RigError as exc:
             first_error = first_error or exc
         except (np.linalg.LinAlgError, ValueError, FloatingPointError) as exc:  # a start gone numerically wrong
@@ -245,6 +249,8 @@ def _global_rest_pose(rig: Rig) -> Rest:
     if not found:
         raise first_error
     lowest = min(r.com[2] for r in found)
+    if indeterminate is not None and indeterminate.height < lowest - 1e-9 * rig_scale(rig):
+        raise indeterminate  # e.g. four parallel wires: a higher, twisted pose is not the rest pose
     return next(r for r in found if r.com[2] <= lowest + 1e-9 * rig_scale(rig))
 
 
@@ -338,6 +344,14 @@ def _search(rig: Rig, start: np.ndarray) -> Rest:
     return rest
 
 
+class Indeterminate(RigError):
+    """Dependent wire constraints at a pose whose COM is ``height`` (m, world z) high."""
+
+    def __init__(self, source: str, field_name: str, problem: str, height: float):
+        super().__init__(source, field_name, problem)
+        self.height = height
+
+
 def check_determinate(rig: Rig, com: np.ndarray, rotation: np.ndarray) -> None:
     """Refuse wires whose constraints are dependent at this pose (four parallel wires, or more than
     six): the tensions of inextensible wires are then not fixed by rigid-body statics or dynamics
@@ -349,11 +363,11 @@ def check_determinate(rig: Rig, com: np.ndarray, rotation: np.ndarray) -> None:
     rank = int(np.sum(sv > NULL_RTOL * sv[0]))
     n = len(rig.wires)
     if rank < n:
-        raise RigError(
+        raise Indeterminate(
             rig.source, "wire",
             f"{n} wires but only {rank} independent wire constraints at rest: the tensions of inextensible "
             "wires are statically indeterminate (redundant wires share the load by their stretch, which "
-            "this rig file has no stiffness for)",
+            "this rig file has no stiffness for: give every wire an axial_stiffness)", float(com[2]),
         )
 
 
