@@ -111,3 +111,22 @@ def test_kane_and_mujoco_agree_on_elastic_rigs():
     # The issue's bars: COM to 1e-5 m, tensions to 1e-3 of the static one (MuJoCo at 2e-5 s).
     failed = [(m.name, m.value, m.tolerance) for m in _metrics(E.elastic_engines) if not m.passed]
     assert not failed
+
+
+def test_axial_stiffness_sweep_axis_and_continuation(tmp_path):
+    # The sweep's axis makes every wire elastic; its rows continue from the neighbour's pose but are
+    # the elastic rig's own modes (the compiled continuation is the inextensible one's: bypassed).
+    from bifilar.sweep.evaluate import evaluate
+    from bifilar.sweep.space import load_space
+
+    path = tmp_path / "ea.toml"
+    path.write_text(f'rig = "{RIGS / "soft_cords.toml"}"\n\n[vary]\naxial_stiffness = [4000.0, 40000.0]\n\n'
+                    '[measure]\naxes = ["z"]\n')
+    space = load_space(path)
+    first = evaluate(space, {"axial_stiffness": 4000.0})
+    second = evaluate(space, {"axial_stiffness": 40000.0}, guess=first.rest)
+    for row, ea in ((first, 4000.0), (second, 40000.0)):
+        direct = sorted((m.period for m in linearize(E.with_ea(rig("soft_cords"), ea)).modes), reverse=True)[:4]
+        assert np.allclose(row.periods, direct, rtol=1e-9)  # the same linearisation: rounding only
+    # ten times stiffer: the sway period shifts by ~ (eps_1 - eps_2) / 2 ~ 1e-3 (eps_1 = 2.5e-3)
+    assert 5e-4 < first.periods[0] / second.periods[0] - 1 < 2e-3

@@ -153,7 +153,9 @@ def linear_axes(rig: Rig, periods: dict, period_std: float, rest: Rest | None = 
         k, _, v = pencils[a].associated(bases[a].moment)
         shapes[n] = lin.basis @ v[:, k]
         inertias[n] = with_moment(rig, a, bases[a].moment).inertia
-    table, ok = kernel_slopes(rig, rest, inp, shapes, inertias)
+    # The compiled kernel continues inextensible wires; elastic ones (their stretch is in every changed
+    # rig: apply keeps axial_stiffness) take the general path.
+    table, ok = (None, False) if rig.elastic else kernel_slopes(rig, rest, inp, shapes, inertias)
     slopes = {a: table[n] for n, a in enumerate(axes)} if ok else _slopes_resolved(rig, rest, inp, bases)
     return {a: propagate(b, slopes[a], inputs(b.rig, periods[a], period_std)) for a, b in bases.items()}
 
