@@ -234,7 +234,7 @@ def _global_rest_pose(rig: Rig) -> Rest:
         starts.append(_hanging_orientation(rig, with_com=False))
         turns = Rotation.random(MULTI_STARTS, random_state=_START_SEED).as_matrix()
         starts += [turn @ hanging for turn in turns]
-    found, first_error, indeterminate = [], None, None
+    found, first_error, indeterminate, numerical = [], None, None, None
     for start in starts:
         try:
             found.append(_search(rig, start))
@@ -245,9 +245,11 @@ def _global_rest_pose(rig: Rig) -> Rest:
         except RigError as exc:
             first_error = first_error or exc
         except (np.linalg.LinAlgError, ValueError, FloatingPointError) as exc:  # a start gone numerically wrong
-            first_error = first_error or RigError(rig.source, "wire", f"no equilibrium with every wire taut found ({exc})")
+            numerical = numerical or exc
     if not found:
-        raise first_error
+        # Every start failed: a stated reason (a slack wire, no taut pose) if one gave it, else the
+        # numerical failure itself (exit 4, as any failure inside the physics).
+        raise first_error or numerical
     lowest = min(r.com[2] for r in found)
     if indeterminate is not None and indeterminate.height < lowest - 1e-9 * rig_scale(rig):
         raise indeterminate  # e.g. four parallel wires: a higher, twisted pose is not the rest pose
