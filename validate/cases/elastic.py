@@ -189,10 +189,10 @@ def stiff_limit(ctx: CaseContext):
         diffs.append((d_period, d_tension))
         out += [check(f"EA = {ea:g} N: slow periods vs inextensible / eps", d_period / eps, 1.0,
                       "a stretch eps lengthens a pendulum of length L by eps L: its period by eps / 2"),
-                check(f"EA = {ea:g} N: rest tensions vs inextensible / (W eps)", d_tension / eps, 10.0,
-                      "the stretch turns the wires by ~eps rad; unequal wires share the weight ~1/eps-sensitively")]
+                check(f"EA = {ea:g} N: rest tensions vs inextensible / (W eps)", d_tension / eps, 1.0,
+                      "O(eps): the stretch turns the wires by ~eps rad, shifting the shares by ~eps W (measured 0.11)")]
     for k, label in enumerate(("periods", "tensions")):
-        out.append(check(f"first order: {label} difference ratio at 10 x EA", diffs[1][k] / diffs[0][k] * 10.0 - 1.0, 0.05,
+        out.append(check(f"first order: {label} difference ratio at 10 x EA", abs(diffs[1][k] / diffs[0][k] * 10.0 - 1.0), 0.05,
                          "a first-order effect: the ratio is 1/10 up to O(eps) = 1e-5", ))
     return out
 
