@@ -278,6 +278,7 @@ def _cmd_modes(args) -> int:
         },
         "modes": [
             {"motion": m.motion, "period": m.period, "frequency": m.frequency, "omega2": m.omega2,
+             **({"kind": _mode_kind(m), "stretch_share": m.stretch_share} if rig.elastic else {}),
              "com_shape": m.com.tolist(), "rotation_shape": m.rotation.tolist()}
             for m in lin.modes
         ],
@@ -288,9 +289,15 @@ def _cmd_modes(args) -> int:
     print(f"rig {rig.name}: rest COM {_fmt(rest.com)} m, tensions {_fmt(rest.tensions)} N")
     for i, m in enumerate(lin.modes, start=1):
         period = "neutral" if m.period is None else f"{m.period:.9g} s ({m.frequency:.6g} Hz)"
-        print(f"  mode {i} ({m.motion}): period {period}; COM shape {_fmt(m.com)} m, "
+        kind = f", {_mode_kind(m)}: {m.stretch_share:.3g} of its energy in wire stretch" if rig.elastic else ""
+        print(f"  mode {i} ({m.motion}{kind}): period {period}; COM shape {_fmt(m.com)} m, "
               f"rotation shape {_fmt(m.rotation)} rad")
     return 0
+
+
+def _mode_kind(mode) -> str:
+    """``fast`` for a mode held by the wires' stretch (bounce, roll, pitch), ``slow`` for a pendulum mode."""
+    return "fast" if mode.stretch_share > 0.5 else "slow"
 
 
 def _cmd_simulate(args) -> int:

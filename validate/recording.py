@@ -284,6 +284,10 @@ def _summary(title: str, runs: list[_Run], metrics: list[Metric], passed: bool |
         stop = f", taut-wire model stopped at t = {failure[1]:.6g} s (wire {failure[0]})" if failure else ""
         lines.append(f"- {r.label}: engine {r.traj.engine}, rig {r.traj.meta.get('rig', '-')}, "
                      f"{len(r.traj.t)} samples over {r.traj.t[0]:g}..{r.traj.t[-1]:g} s{stop}")
+        spec = r.traj.meta.get("rig_spec")
+        if spec is not None and spec.elastic:  # the stiffness the run used; length_error is the stretch
+            lines.append("  elastic wires, axial stiffness EA = " + ", ".join(f"{w.axial_stiffness:.6g}" for w in spec.wires)
+                         + " N (length error = stretch beyond the unstretched length)")
     return "\n".join(lines) + "\n"
 
 

@@ -89,8 +89,9 @@ def _layout(n_wires: int) -> tuple[tuple[str, ...], tuple[str, ...]]:
 def apply(rig: Rig, x: np.ndarray) -> tuple[Rig, float]:
     """The rig and period with the input vector ``x`` (in the order of :func:`inputs`)."""
     wires, j = [], 0
-    for _ in rig.wires:
-        wires.append(Wire(anchor=x[j + 1 : j + 4].copy(), attach=x[j + 4 : j + 7].copy(), length=float(x[j])))
+    for w in rig.wires:  # an elastic wire keeps its axial stiffness: the stretch is in the propagation
+        wires.append(Wire(anchor=x[j + 1 : j + 4].copy(), attach=x[j + 4 : j + 7].copy(), length=float(x[j]),
+                          axial_stiffness=w.axial_stiffness))
         j += 7
     changed = replace(rig, wires=tuple(wires), mass=float(x[j]), com=x[j + 1 : j + 4].copy())
     return changed, float(x[j + 4])
@@ -152,7 +153,9 @@ def linear_axes(rig: Rig, periods: dict, period_std: float, rest: Rest | None = 
         k, _, v = pencils[a].associated(bases[a].moment)
         shapes[n] = lin.basis @ v[:, k]
         inertias[n] = with_moment(rig, a, bases[a].moment).inertia
-    table, ok = kernel_slopes(rig, rest, inp, shapes, inertias)
+    # The compiled kernel continues inextensible wires; elastic ones (their stretch is in every changed
+    # rig: apply keeps axial_stiffness) take the general path.
+    table, ok = (None, False) if rig.elastic else kernel_slopes(rig, rest, inp, shapes, inertias)
     slopes = {a: table[n] for n, a in enumerate(axes)} if ok else _slopes_resolved(rig, rest, inp, bases)
     return {a: propagate(b, slopes[a], inputs(b.rig, periods[a], period_std)) for a, b in bases.items()}
 

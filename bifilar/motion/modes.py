@@ -13,6 +13,14 @@ thesis's angles theta_1..5 have one where the attachment line turns steeply, whi
 linearisation through them wrong there). On two-wire rigs it agrees with the exact linearisation of the
 Kane-Tseng equations where their chart is regular (case ``kane-modes-spectrum``, tests/test_modes.py).
 
+Elastic wires (``axial_stiffness``, :mod:`bifilar.rig.elastic`) leave the body all six directions:
+Z = I and K = hess V = sum_taut k_i J_i^T J_i + sum_i t_i H_i, the wires' axial stiffness plus the
+geometric stiffness of their tension (the second term is the inextensible K before the null-space
+restriction). The six modes are three slow ones (``sway x``, ``sway y``, ``yaw``: the pendulum's, which
+hardly stretch a wire) and three fast ones, which do: ``bounce`` (the COM's vertical motion), ``roll`` and
+``pitch`` (turning about world x and y). :attr:`Mode.stretch_share` is the share of a mode's potential
+energy that is wire stretch: ~1 for the fast modes, ~T / EA for the slow ones.
+
 Each mode is named by the motion that holds most of its kinetic energy: ``sway x`` / ``sway y`` (COM
 along world x / y), ``yaw`` (turning about world z) or ``tilt`` (turning about a horizontal axis, with
 the COM's vertical motion). Modes of equal frequency (a symmetric trifilar's two sways) are resolved
@@ -28,12 +36,14 @@ from scipy.linalg import eigh
 
 from bifilar.bodies.air import added_mass
 from bifilar.rig import Rig
+from bifilar.rig import elastic
 from bifilar.rig import pose_kernel as PK
 from bifilar.rig.statics import NULL_RTOL, Rest, State, anchors, arms, rest_pose, rig_scale
 
 NEUTRAL_RTOL = 1e-9  # an eigenvalue below this fraction of the largest is neutral (or unstable)
 DEGENERATE_RTOL = 1e-9  # eigenvalues closer than this fraction of the largest are one frequency
 MOTIONS = ("sway x", "sway y", "yaw", "tilt")
+ELASTIC_MOTIONS = ("sway x", "sway y", "yaw", "bounce", "roll", "pitch")  # elastic wires: six modes
 # Pose directions (x, theta) tried in this order to resolve a degenerate eigenspace.
 _PREFERRED = np.eye(6)[[0, 1, 5, 3, 4, 2]]
 
@@ -49,6 +59,7 @@ class Mode:
     com: np.ndarray
     rotation: np.ndarray
     motion: str
+    stretch_share: float = 0.0  # of the potential energy of the mode's shape, the wires' stretch: 0 inextensible
 
     @property
     def frequency(self) -> float | None:
@@ -77,10 +88,17 @@ class Modes:
 
 def reduced(rig: Rig, rest: Rest) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(Z, M, K) about ``rest`` (see the module docstring); with ``[air]``, M gains Z^T M_A,w Z."""
-    z, mr, kr, _ = PK.reduced_matrices(
-        rest.com, rest.rotation, rest.tensions, arms(rig), anchors(rig), rig.inertia, rig.mass,
-        rig_scale(rig), NULL_RTOL,
-    )
+    if rig.elastic:
+        z = np.eye(6)
+        mr = np.zeros((6, 6))
+        mr[:3, :3] = rig.mass * np.eye(3)
+        mr[3:, 3:] = rest.rotation @ rig.inertia @ rest.rotation.T
+        kr = elastic.stiffness(rig, rest.com, rest.rotation, arms(rig), anchors(rig))
+    else:
+        z, mr, kr, _ = PK.reduced_matrices(
+            rest.com, rest.rotation, rest.tensions, arms(rig), anchors(rig), rig.inertia, rig.mass,
+            rig_scale(rig), NULL_RTOL,
+        )
     if rig.air is not None:
         mr = mr + z.T @ air_mass_world(rig, rest) @ z
     return z, mr, kr
@@ -99,6 +117,16 @@ def motion_of(rig: Rig, rest: Rest, com: np.ndarray, rotation: np.ndarray) -> st
     """The motion holding most of the kinetic energy of a shape (COM and rotation, world)."""
     inertia = rest.rotation @ rig.inertia @ rest.rotation.T
     horizontal = np.array([rotation[0], rotation[1], 0.0])
+    if rig.elastic:
+        energy = {
+            "sway x": rig.mass * com[0] ** 2,
+            "sway y": rig.mass * com[1] ** 2,
+            "yaw": inertia[2, 2] * rotation[2] ** 2,
+            "bounce": rig.mass * com[2] ** 2,
+            "roll": inertia[0, 0] * rotation[0] ** 2,
+            "pitch": inertia[1, 1] * rotation[1] ** 2,
+        }
+        return max(ELASTIC_MOTIONS, key=energy.__getitem__)
     energy = {
         "sway x": rig.mass * com[0] ** 2,
         "sway y": rig.mass * com[1] ** 2,
@@ -167,9 +195,23 @@ def linearize(rig: Rig, rest: Rest | None = None) -> Modes:
         norm = max(np.linalg.norm(rot), np.linalg.norm(com) / scale)
         neutral = w2[k] <= NEUTRAL_RTOL * max(abs(w2).max(), 1e-300)
         period = None if neutral else float(2.0 * np.pi / np.sqrt(w2[k]))
-        modes.append(Mode(period, float(w2[k]), com / norm, rot / norm, motion_of(rig, rest, com, rot)))
+        modes.append(Mode(period, float(w2[k]), com / norm, rot / norm, motion_of(rig, rest, com, rot),
+                          _stretch_share(rig, rest, shape)))
     modes.sort(key=lambda m: (m.period is not None, -(m.period or 0.0)))
     return Modes(rest, tuple(modes), mr, kr, z)
+
+
+def _stretch_share(rig: Rig, rest: Rest, shape: np.ndarray) -> float:
+    """(sum k_i (J_i q)^2) / (q^T K q) for the pose shape q: the share of the mode's potential energy
+    stored in stretching the wires (0 for inextensible wires)."""
+    if not rig.elastic:
+        return 0.0
+    s, u, rho = PK.wire_geometry(rest.com, rest.rotation, arms(rig), anchors(rig))
+    rates = PK.constraint_jacobian(s, u) @ shape
+    taut = rest.tensions > 0.0
+    axial = float(elastic.springs(rig)[taut] @ rates[taut] ** 2)
+    total = float(shape @ elastic.stiffness(rig, rest.com, rest.rotation, arms(rig), anchors(rig)) @ shape)
+    return axial / total if total > 0.0 else 0.0
 
 
 def excite(lin: Modes, index: int, amplitude: float) -> State:

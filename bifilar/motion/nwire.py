@@ -10,6 +10,10 @@ removes only the constraint-violating kinetic energy) and integration restarts t
 Integration is scipy's DOP853 (rtol 1e-10 by default); outputs come from its dense output on a
 uniform grid. A wire whose tension reaches zero stops the run (``slack = (wire, time)``), as in the
 two-wire Kane-Tseng model (:mod:`bifilar.motion.simulate`): the taut-wire model ends there.
+
+Elastic wires (``axial_stiffness``): the body is free in six directions and each wire a force element
+pulling with k_i max(0, rho_i - L_i) (:mod:`bifilar.motion.elastic_kernel`, docs/elastic-wires.md): no
+constraint to project onto, and a slack wire is simply one that pulls nothing, so the run goes on.
 """
 
 from __future__ import annotations
@@ -20,6 +24,7 @@ import numpy as np
 from scipy.integrate import solve_ivp
 from scipy.spatial.transform import Rotation
 
+from bifilar.motion import elastic_kernel as EK
 from bifilar.motion import nwire_kernel as NK
 from bifilar.motion.kane import air_vector
 from bifilar.motion.simulate import Budget, IntegrationError, Meter, output_grid
@@ -44,6 +49,7 @@ class NWireModel:
     mass: float
     gravity: float
     air: np.ndarray  # the air's added mass, ellipsoid and drag (bifilar.motion.kane.air_vector); zeros in a vacuum
+    springs: np.ndarray | None = None  # EA / L per wire (N/m) for elastic wires; None: inextensible
 
     @classmethod
     def from_rig(cls, rig: Rig) -> "NWireModel":
@@ -56,11 +62,16 @@ class NWireModel:
             mass=float(rig.mass),
             gravity=float(rig.gravity),
             air=air_vector(rig),
+            springs=np.array([w.spring for w in rig.wires]) if rig.elastic else None,
         )
 
     @property
     def args(self):
         return self.arms, self.anchors, self.inertia, self.mass, self.gravity, self.air
+
+    @property
+    def elastic_args(self):
+        return self.arms, self.anchors, self.lengths, self.springs, self.inertia, self.mass, self.gravity, self.air
 
     @property
     def scale(self) -> float:
@@ -124,6 +135,8 @@ def simulate(model: NWireModel, state: State, duration: float, dt_out: float = 0
     atol = 1e-2 * rtol if atol is None else atol
     grid = output_grid(duration, dt_out)
     y = state_vector(state)
+    if model.springs is not None:
+        return _simulate_elastic(model, y, grid, rtol, atol, meter)
     rot = NK.quat_matrix(y[3:7])
     check_determinate(model.rig, y[:3], rot)  # dependent wires: tensions undetermined
     args = model.args
@@ -155,6 +168,30 @@ def simulate(model: NWireModel, state: State, duration: float, dt_out: float = 0
         y = project(model, sol.sol(t1))
         t0 = t1
     return _sampled_run(model, samples, grid, nfev, slack)
+
+
+def _simulate_elastic(model: NWireModel, y: np.ndarray, grid: np.ndarray, rtol: float, atol: float,
+                      meter: Meter) -> NWireRun:
+    """Elastic wires: one DOP853 integration of the free body under the wire forces."""
+    args = model.elastic_args
+
+    def rhs(t, yy):
+        meter.tick(t)
+        return EK.rhs(yy, *args)
+
+    samples = [y[None, :]]
+    nfev = 0
+    if grid[-1] > 0.0:
+        sol = solve_ivp(rhs, (0.0, float(grid[-1])), y, method="DOP853", t_eval=grid[1:], rtol=rtol, atol=atol)
+        nfev = sol.nfev
+        if sol.status == -1:
+            raise IntegrationError(f"nwire integration failed at t = {sol.t[-1] if sol.t.size else 0.0:.6g} s: {sol.message}")
+        samples.append(sol.y.T)
+    Y = np.ascontiguousarray(np.concatenate(samples), dtype=float)
+    frames, tension, stretch, energy = EK.observe(Y, *args)
+    return NWireRun(t=grid[: len(Y)], com=Y[:, :3].copy(), rotation=frames, velocity=Y[:, 7:10].copy(),
+                    omega=Y[:, 10:13].copy(), tension=tension, length_error=stretch, energy=energy, nfev=nfev,
+                    slack=None)
 
 
 def _slack_event(args, wire: int):

@@ -40,11 +40,19 @@ __all__ = ["Rig", "RigError", "Uncertainty", "Wire", "load_rig", "rig_from_dict"
 
 @dataclass(frozen=True)
 class Wire:
-    """An inextensible massless wire from a ceiling ``anchor`` (world, m) to ``attach`` (body, m)."""
+    """A massless wire from a ceiling ``anchor`` (world, m) to ``attach`` (body, m): inextensible of
+    ``length`` (m) when ``axial_stiffness`` is None, else elastic: ``length`` is its unstretched length
+    and it pulls with EA (d - L) / L at a distance d > L (``axial_stiffness`` = EA, N), never pushes."""
 
     anchor: np.ndarray
     attach: np.ndarray
     length: float
+    axial_stiffness: float | None = None
+
+    @property
+    def spring(self) -> float:
+        """EA / L (N/m), the elastic wire's spring constant; inf for an inextensible wire."""
+        return np.inf if self.axial_stiffness is None else self.axial_stiffness / self.length
 
 
 @dataclass(frozen=True)
@@ -75,6 +83,11 @@ class Rig:
     source: str = "<memory>"
     air: Air | None = None  # the optional [air] table (bifilar.bodies.air); None: a vacuum
 
+    @property
+    def elastic(self) -> bool:
+        """True when any wire has an ``axial_stiffness`` (then every wire must: :func:`rig_from_dict`)."""
+        return any(w.axial_stiffness is not None for w in self.wires)
+
     def with_initial(self, rotation=(0.0, 0.0, 0.0), omega=(0.0, 0.0, 0.0)) -> "Rig":
         """The same rig with another initial disturbance (rotation vector and angular velocity)."""
         return replace(
@@ -86,7 +99,7 @@ class Rig:
 
 _TOP_KEYS = {"name", "gravity", "body", "wire", "initial", "uncertainty", "air"}
 _BODY_KEYS = {"mass", "com", "inertia"}
-_WIRE_KEYS = {"anchor", "attach", "length"}
+_WIRE_KEYS = {"anchor", "attach", "length", "axial_stiffness"}
 _INITIAL_KEYS = {"rotation", "omega"}
 _UNCERTAINTY_KEYS = set(Uncertainty.__dataclass_fields__)
 
@@ -132,8 +145,15 @@ def rig_from_dict(data: dict, source: str = "<memory>", default_name: str = "rig
                 anchor=vector3(required(w, "anchor", source, prefix), source, prefix + "anchor"),
                 attach=vector3(required(w, "attach", source, prefix), source, prefix + "attach"),
                 length=positive(required(w, "length", source, prefix), source, prefix + "length"),
+                axial_stiffness=(positive(w["axial_stiffness"], source, prefix + "axial_stiffness")
+                                 if "axial_stiffness" in w else None),
             )
         )
+    given = [w.axial_stiffness is not None for w in wires]
+    if any(given) and not all(given):
+        first = given.index(not given[0]) + 1
+        raise RigError(source, f"wire[{first}].axial_stiffness", "give every wire an axial_stiffness or none: a rig "
+                       "mixing elastic and inextensible wires is not modelled")
 
     initial = table(data, "initial", source, mandatory=False)
     no_unknown(initial, _INITIAL_KEYS, source, "initial.")

@@ -23,6 +23,7 @@ RANGES = {
     "gravity": (0.1, 100.0, "m/s^2", "from a small moon to ten times the Earth's"),
     "body.mass": (1e-3, 1e6, "kg", "from a gram to a thousand tonnes"),
     "wire[i].length": (1e-3, 1e3, "m", "from a millimetre to a kilometre"),
+    "wire[i].axial_stiffness": (1.0, 1e10, "N", "E A: from a thin rubber cord to a 10 cm steel bar"),
     "coordinates": (-1e4, 1e4, "m", "every component of anchor, attach and com"),
     "air.density": (1e-3, 2e3, "kg/m^3", "from thin air to twice water's"),
     "air.viscosity": (0.0, 10.0, "Pa s", "0 (inviscid) to ten thousand times water's"),
@@ -71,6 +72,9 @@ def check_ranges(rig, free_moment: int | None = None) -> None:
                 within(float(x), low, high, src, f"wire[{i}].{name}[{k}]", unit, why)
         lo, hi, u, reason = RANGES["wire[i].length"]
         within(w.length, lo, hi, src, f"wire[{i}].length", u, reason)
+        if w.axial_stiffness is not None:
+            lo, hi, u, reason = RANGES["wire[i].axial_stiffness"]
+            within(w.axial_stiffness, lo, hi, src, f"wire[{i}].axial_stiffness", u, reason)
 
     size = rig_size(rig.wires)
     span = float(np.linalg.norm(rig.wires[0].attach - rig.wires[1].attach))

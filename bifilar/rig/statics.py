@@ -19,7 +19,7 @@ world frame). Both engines start from :func:`initial_state`, so that they integr
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from scipy.optimize import least_squares, minimize
@@ -122,7 +122,13 @@ def rest_pose(rig: Rig, guess: Rest | None = None) -> Rest:
 
     Raises :class:`RigError` if no pose holds every wire taut (a wire would have to push) or the
     equilibrium found is not stable.
+
+    Elastic wires (``axial_stiffness``): the lowest minimum of the potential energy, gravity plus the
+    wires' strain energy (:mod:`bifilar.rig.elastic`), from ``guess``, the inextensible rest pose of
+    the same wires where that is determinate, and the starts of the inextensible search.
     """
+    if rig.elastic:
+        return _elastic_rest_pose(rig, guess)
     if guess is not None:
         rest = _polish(rig, guess.com, guess.rotation, guess.tensions)
         if rest is not None and _stable(rig, rest):
@@ -130,6 +136,50 @@ def rest_pose(rig: Rig, guess: Rest | None = None) -> Rest:
             # representative as without a guess.
             return Rest(rest.com, _nearest_on_neutral_axis(rig, rest.com, rest.rotation), rest.tensions)
     return _global_rest_pose(rig)
+
+
+def _elastic_rest_pose(rig: Rig, guess: Rest | None) -> Rest:
+    from bifilar.rig import elastic
+
+    if guess is not None:  # continuation: Newton from the nearby rig's pose, else the full search
+        try:
+            com, rotation, tensions = elastic.rest_pose(rig, [(guess.com, guess.rotation)], arms(rig), anchors(rig),
+                                                        rig_scale(rig))
+            if tensions.min() > 0.0:
+                return Rest(com=com, rotation=rotation, tensions=tensions)
+        except RigError:
+            pass
+    starts = []
+    if len(rig.wires) <= 3:
+        # The inextensible pose, a stretch away from the elastic one: two or three wires only, where it is
+        # determinate and cheap (four or more take the multi-start search, which fails on every start of
+        # four parallel wires: measured ~6 s per quadrifilar MuJoCo run; its elastic rest pose is 8 ms).
+        rigid = replace(rig, wires=tuple(replace(w, axial_stiffness=None) for w in rig.wires))
+        try:
+            rest = _global_rest_pose(rigid)
+            starts.append((rest.com, rest.rotation))
+        except (RigError, np.linalg.LinAlgError):
+            pass
+    for start in (np.eye(3), _hanging_orientation(rig)):
+        starts.append((_start_com(rig, start), start))
+    com, rotation, tensions = elastic.rest_pose(rig, starts, arms(rig), anchors(rig), rig_scale(rig))
+    slack = np.flatnonzero(tensions <= 0.0)
+    if slack.size:
+        i = int(slack[0])
+        raise RigError(rig.source, f"wire[{i + 1}]", "would be slack at rest (shorter than its unstretched length): "
+                       "the body cannot hang taut on every wire")
+    return Rest(com=com, rotation=rotation, tensions=tensions)
+
+
+def _start_com(rig: Rig, rotation: np.ndarray) -> np.ndarray:
+    """A COM for the body turned by ``rotation``: under the anchors' centroid by the mean wire length,
+    then the shortest shift putting every wire at its length where there is one."""
+    guess = anchors(rig).mean(axis=0) - np.array([0.0, 0.0, lengths(rig).mean()])
+    guess = guess - rotation @ (np.array([w.attach for w in rig.wires]).mean(axis=0) - rig.com)
+    try:
+        return guess + taut_shift(rig, guess, rotation)
+    except (RigError, np.linalg.LinAlgError):  # no taut pose at this orientation: the minimiser finds one
+        return guess
 
 
 def _polish(rig: Rig, com: np.ndarray, rotation: np.ndarray, tensions: np.ndarray) -> Rest | None:
@@ -168,31 +218,59 @@ def _global_rest_pose(rig: Rig) -> Rest:
     orientation that best lays the attachments under their anchors, :func:`_hanging_orientation`),
     from that orientation too. Of the stable equilibria found the lowest (least potential) is the rest
     pose: from a far start SLSQP can settle in a higher, twisted equilibrium (wires crossed) that is
-    stable too. Ties keep the file's orientation's."""
+    stable too. Ties keep the file's orientation's.
+
+    Four or more wires have several taut equilibria far apart more often (a 4-wire body has two
+    directions of freedom, a 6-wire one none: its poses are isolated points), and one start stopped in
+    a local minimum or failed (issue 20). They get :data:`MULTI_STARTS` more starts: the hanging
+    orientation without the COM's row, and that orientation turned by fixed rotations spread over the
+    sphere; a start that fails in any way (no taut pose there, a singular matrix) is skipped, and the
+    error of the first start is raised only if no start succeeds."""
     starts = [np.eye(3)]
     hanging = _hanging_orientation(rig)
     if Rotation.from_matrix(hanging).magnitude() > _FAR_START:
         starts.append(hanging)
-    found, first_error = [], None
+    if len(rig.wires) >= 4:
+        starts.append(_hanging_orientation(rig, with_com=False))
+        turns = Rotation.random(MULTI_STARTS, random_state=_START_SEED).as_matrix()
+        starts += [turn @ hanging for turn in turns]
+    found, first_error, indeterminate, numerical = [], None, None, None
     for start in starts:
         try:
             found.append(_search(rig, start))
+        except Indeterminate as exc:  # the lowest of these, if below every pose found, is the answer
+            if indeterminate is None or exc.height < indeterminate.height:
+                indeterminate = exc
+            first_error = first_error or exc
         except RigError as exc:
             first_error = first_error or exc
+        except (np.linalg.LinAlgError, ValueError, FloatingPointError) as exc:  # a start gone numerically wrong
+            numerical = numerical or exc
     if not found:
-        raise first_error
+        # Every start failed: a stated reason (a slack wire, no taut pose) if one gave it, else the
+        # numerical failure itself (exit 4, as any failure inside the physics).
+        raise first_error or numerical
     lowest = min(r.com[2] for r in found)
+    if indeterminate is not None and indeterminate.height < lowest - 1e-9 * rig_scale(rig):
+        raise indeterminate  # e.g. four parallel wires: a higher, twisted pose is not the rest pose
     return next(r for r in found if r.com[2] <= lowest + 1e-9 * rig_scale(rig))
 
 
-def _hanging_orientation(rig: Rig) -> np.ndarray:
+# Extra rest-pose starts for four or more wires, and the seed of their fixed, reproducible rotations.
+MULTI_STARTS = 12
+_START_SEED = 20
+
+
+def _hanging_orientation(rig: Rig, with_com: bool = True) -> np.ndarray:
     """The rotation (body -> world) that best maps the attachments to points hanging straight under
-    their anchors, each by its wire's length, and the COM under their centroid by its body-frame
-    distance from the attachments' centroid (Kabsch: the SVD of the points' cross-covariance)."""
+    their anchors, each by its wire's length, and (``with_com``) the COM under their centroid by its
+    body-frame distance from the attachments' centroid (Kabsch: the SVD of the points' cross-covariance)."""
     body = np.array([w.attach for w in rig.wires] + [rig.com])
     under = anchors(rig) - np.outer(lengths(rig), [0.0, 0.0, 1.0])
     drop = np.linalg.norm(rig.com - body[:-1].mean(axis=0))
     world = np.vstack([under, under.mean(axis=0) - [0.0, 0.0, drop]])
+    if not with_com:
+        body, world = body[:-1], world[:-1]
     u, _, vt = np.linalg.svd((world - world.mean(axis=0)).T @ (body - body.mean(axis=0)))
     d = np.sign(np.linalg.det(u @ vt)) or 1.0
     return u @ np.diag([1.0, 1.0, d]) @ vt
@@ -268,6 +346,14 @@ def _search(rig: Rig, start: np.ndarray) -> Rest:
     return rest
 
 
+class Indeterminate(RigError):
+    """Dependent wire constraints at a pose whose COM is ``height`` (m, world z) high."""
+
+    def __init__(self, source: str, field_name: str, problem: str, height: float):
+        super().__init__(source, field_name, problem)
+        self.height = height
+
+
 def check_determinate(rig: Rig, com: np.ndarray, rotation: np.ndarray) -> None:
     """Refuse wires whose constraints are dependent at this pose (four parallel wires, or more than
     six): the tensions of inextensible wires are then not fixed by rigid-body statics or dynamics
@@ -279,11 +365,11 @@ def check_determinate(rig: Rig, com: np.ndarray, rotation: np.ndarray) -> None:
     rank = int(np.sum(sv > NULL_RTOL * sv[0]))
     n = len(rig.wires)
     if rank < n:
-        raise RigError(
+        raise Indeterminate(
             rig.source, "wire",
             f"{n} wires but only {rank} independent wire constraints at rest: the tensions of inextensible "
             "wires are statically indeterminate (redundant wires share the load by their stretch, which "
-            "this rig file has no stiffness for)",
+            "this rig file has no stiffness for: give every wire an axial_stiffness)", float(com[2]),
         )
 
 
@@ -409,6 +495,8 @@ def initial_state(rig: Rig, rest: Rest | None = None) -> State:
     """The rig's initial state, exactly as the rig file's ``[initial]`` table defines it."""
     rest = rest_pose(rig) if rest is None else rest
     rotation = Rotation.from_rotvec(rig.initial_rotation).as_matrix() @ rest.rotation
+    if rig.elastic:
+        return _elastic_initial_state(rig, rest, rotation)
     try:
         com = rest.com + taut_shift(rig, rest.com, rotation)
     except RigError as exc:
@@ -428,3 +516,19 @@ def initial_state(rig: Rig, rest: Rest | None = None) -> State:
         raise RigError(rig.source, "initial.omega", f"no COM velocity keeps every wire at its length "
                        f"(mismatch {miss:.3g} m/s): this spin stretches a wire")
     return State(com=com, rotation=rotation, velocity=velocity, omega=omega)
+
+
+def _elastic_initial_state(rig: Rig, rest: Rest, rotation: np.ndarray) -> State:
+    """Elastic wires: the body turned about its COM by ``initial.rotation`` and held at that orientation
+    while its COM settles (the minimum of the potential over the COM position, :mod:`bifilar.rig.elastic`),
+    then released with ``initial.omega`` and no COM velocity. A wire may be slack there: it pushes
+    nothing. For stiff wires this tends to the inextensible rig's taut shift where the lowest COM on the
+    wire spheres is also the nearest (a turn about the vertical: a pure rise)."""
+    from bifilar.rig import elastic
+
+    com, _, _, ok = elastic.minimise(rig, rest.com, rotation, arms(rig), anchors(rig), rig_scale(rig),
+                                     fixed_rotation=True)
+    if not ok:
+        raise RigError(rig.source, "initial.rotation", "the body turned this far finds no rest for its COM on the "
+                       "elastic wires")
+    return State(com=com, rotation=rotation, velocity=np.zeros(3), omega=np.asarray(rig.initial_omega, dtype=float))

@@ -19,6 +19,8 @@ midpoint and the direction are the base rig's; "height" axes move along world z 
 - ``platform_radius``: every attachment at this horizontal distance (m) from the body-frame vertical
   through the attachments' centroid, and every anchor at it from the world vertical through the
   anchors' centroid, each along its own direction (vertical wires stay vertical).
+- ``axial_stiffness``: every wire's E A (N): the wires become elastic, ``length`` their unstretched
+  length (docs/elastic-wires.md).
 """
 
 from __future__ import annotations
@@ -101,6 +103,10 @@ def platform_radius(rig: Rig, value: float) -> Rig:
     return replace(rig, wires=tuple(replace(w, attach=a, anchor=b) for w, a, b in zip(rig.wires, attach, anchor)))
 
 
+def axial_stiffness(rig: Rig, value: float) -> Rig:
+    return replace(rig, wires=tuple(replace(w, axial_stiffness=value) for w in rig.wires))
+
+
 # Application order: lengths first so that wire_length_2 overrides wire 2's share of wire_length.
 AXES = {
     "wire_length": wire_length,
@@ -111,9 +117,10 @@ AXES = {
     "attach_height": attach_height,
     "anchor_height_difference": anchor_height_difference,
     "platform_radius": platform_radius,
+    "axial_stiffness": axial_stiffness,
 }
 # Axes whose values are distances that must be positive.
-POSITIVE = {"wire_length", "wire_length_2", "anchor_span", "attach_span", "platform_radius"}
+POSITIVE = {"wire_length", "wire_length_2", "anchor_span", "attach_span", "platform_radius", "axial_stiffness"}
 
 
 def configure(rig: Rig, values: dict[str, float]) -> Rig:

@@ -141,7 +141,7 @@ def evaluate(space: Space, values: dict[str, float], guess: Rest | None = None) 
     try:
         rig = configure(space.rig, values)
         check_reachable(rig)
-        if guess is None or rig.air is not None or not _continued(space, rig, row, guess):
+        if guess is None or rig.air is not None or rig.elastic or not _continued(space, rig, row, guess):
             _general(space, rig, row, guess)
     except (RigError, np.linalg.LinAlgError) as exc:
         row.reason = exc.problem if isinstance(exc, RigError) else f"singular: {exc}"

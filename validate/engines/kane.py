@@ -1,5 +1,5 @@
 """The hand-derived models as the ``kane`` engine: Kane-Tseng (:mod:`bifilar.motion.simulate`) for two
-wires, the N-wire model (:mod:`bifilar.motion.nwire`) for three or more."""
+wires, the N-wire model (:mod:`bifilar.motion.nwire`) for three or more and for elastic wires."""
 
 from __future__ import annotations
 
@@ -19,7 +19,7 @@ def run(rig: Rig, duration: float, dt_out: float = 0.01, rtol: float = 1e-10, st
     """Integrate from ``state`` (default: the rig's initial state) within the default work budget and
     ``max_seconds`` of wall time; see :func:`bifilar.motion.simulate.simulate` (two wires) and
     :func:`bifilar.motion.nwire.simulate` (more)."""
-    if len(rig.wires) != 2:
+    if len(rig.wires) != 2 or rig.elastic:  # Kane-Tseng's five angles hold two inextensible wires
         return nwire.run(rig, duration, dt_out, rtol, state, engine="kane", max_seconds=max_seconds)
     model = KaneModel.from_rig(rig)
     start = initial_state(rig) if state is None else state

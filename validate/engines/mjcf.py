@@ -20,6 +20,12 @@ Two cable models (``CABLES``):
     ``connect`` pins a point rather than a distance, so a single-tendon equality is the one built-in
     equality that keeps a point-to-point length.
 
+Elastic wires (``axial_stiffness`` EA): with ``tendon`` cables each tendon is a spring of stiffness
+EA / L with the dead band ``springlength = [0, L]``: MuJoCo's tendon spring pulls with k (l - L) above
+the band and pushes below it, so a band from 0 to L gives exactly "k (l - L) when longer than L, else
+nothing" (measured: no force at l < L). The tendon is unlimited: no constraint row, the spring is a
+passive force. ``equality`` cables cannot go slack or stretch by EA and refuse elastic wires.
+
 Air (``[air]``, docs/air.md): the option's ``density`` and ``viscosity`` and one ellipsoid geom with
 ``fluidshape="ellipsoid"`` at the air's ellipsoid. MuJoCo's ellipsoid model has the same drag terms as
 ours (the ``fluidcoef`` blunt, slender and angular coefficients are the rig's) and no Kutta or Magnus
@@ -131,6 +137,9 @@ def build_spec(rig: Rig, cables: str = "tendon", numerics: Numerics = CHOSEN, sc
         raise RigError(rig.source, "cables", f"unknown cable model {cables!r} (known: {', '.join(CABLES)})")
     if numerics.integrator not in _INTEGRATORS:
         raise RigError(rig.source, "integrator", f"unknown {numerics.integrator!r} (known: {', '.join(_INTEGRATORS)})")
+    if rig.elastic and cables != "tendon":
+        raise RigError(rig.source, "wire[1].axial_stiffness", f"the {cables} cables hold each wire at its length and "
+                       "cannot model elastic wires: use --engine mujoco (tendon springs) or kane")
     rest = rest_pose(rig) if rest is None else rest
     spec = mujoco.MjSpec()
     spec.modelname = rig.name
@@ -167,7 +176,10 @@ def build_spec(rig: Rig, cables: str = "tendon", numerics: Numerics = CHOSEN, sc
         tendon = spec.add_tendon(wire_class, name=f"wire{i}")
         tendon.wrap_site(f"anchor{i}")
         tendon.wrap_site(f"attach{i}")
-        if cables == "tendon":
+        if wire.axial_stiffness is not None:  # a spring that pulls above L only (module docstring)
+            tendon.stiffness[0] = wire.spring
+            tendon.springlength = [0.0, wire.length]
+        elif cables == "tendon":
             tendon.range = [0.0, wire.length]
             tendon.margin = TAUT_MARGIN
     if cables == "equality":
@@ -341,7 +353,9 @@ def _header(rig: Rig, cables: str, numerics: Numerics) -> str:
         f"Rig '{rig.name}' from {rig.source}, written by validate/engines/mjcf.py; see models/README.md.",
         f"Units SI, angles radian; world z up, gravity {rig.gravity:g} m/s^2 along -z. Cables: {cables}.",
         f"body: {rig.mass:g} kg, COM {vec(rig.com)} m (body frame), fullinertia about the COM (body axes).",
-        *(f"wire{i}: anchor {vec(w.anchor)} m (world), attach {vec(w.attach)} m (body), length {w.length!r} m."
+        *(f"wire{i}: anchor {vec(w.anchor)} m (world), attach {vec(w.attach)} m (body), length {w.length!r} m"
+          + ("." if w.axial_stiffness is None else f" unstretched, EA {w.axial_stiffness!r} N: tendon stiffness EA / L, "
+             "springlength [0, L] (pulls only when longer than L).")
           for i, w in enumerate(rig.wires, start=1)),
         "qpos0 and keyframe 'rest': bifilar.statics.rest_pose; keyframe 'initial': the rig's [initial] state.",
         (f"Numerics (models/README.md): timestep {numerics.timestep:g} s, {numerics.integrator}; cable solref "

@@ -155,6 +155,8 @@ def _prepare(rig: Rig, duration: float, state: State | None, cables: str,
                                f"more than the {MAX_STEPS:.3g} one run may take")
     model = mjcf.compile_model(rig, cables, numerics)
     start = initial_state(rig) if state is None else state
+    if rig.elastic:  # springs, no constraint rows: nothing to be ill-conditioned
+        return model, start
     coupling = row_coupling(model, rig, start)
     if coupling > MAX_ROW_COUPLING:
         raise RigError(rig.source, "body.inertia", f"MuJoCo's soft cables are ill-conditioned for this body (row "
@@ -271,6 +273,8 @@ class _Sampler:
         integrator = model.opt.integrator
         self.half = 0.5 * model.opt.timestep if staggered and integrator != mujoco.mjtIntegrator.mjINT_RK4 else 0.0
         self.rows = _cable_rows(model, cables)
+        self.lengths = np.array([w.length for w in rig.wires])
+        self.springs = np.array([w.spring for w in rig.wires])
         self.qpos = np.empty((self.n_out, model.nq))
         self.qvel = np.empty((self.n_out, model.nv))
         self.tension = np.empty((self.n_out, len(rig.wires)))
@@ -281,7 +285,10 @@ class _Sampler:
         mujoco.mj_forward(model, data)
         _check_warnings(data, k * self.dt_out)
         self.qpos[k] = data.qpos
-        self.tension[k] = cable_tensions(data, self.rows) if k else settled_tensions(model, data, self.cables)
+        if self.rig.elastic:  # the tendon springs: k (l - L) above L, else 0, as MuJoCo applies them
+            self.tension[k] = self.springs * np.maximum(data.ten_length - self.lengths, 0.0)
+        else:
+            self.tension[k] = cable_tensions(data, self.rows) if k else settled_tensions(model, data, self.cables)
         self.length[k] = data.ten_length
         if k:
             self.qvel[k] = data.qvel + self.half * data.qacc
@@ -292,6 +299,9 @@ class _Sampler:
     def trajectory(self) -> Trajectory:
         rig, model, tension = self.rig, self.model, self.tension
         channels = rig_channels(rig, self.qpos, self.qvel)
+        if rig.elastic:  # plus the strain energy, as in the N-wire model
+            stretch = np.maximum(self.length - self.lengths, 0.0)
+            channels["energy"] = channels["energy"] + 0.5 * (stretch**2) @ self.springs
         channels["tension"] = tension
         channels["length_error"] = self.length - np.array([w.length for w in rig.wires])
         slack = np.argwhere(tension <= 0.0)

@@ -1,0 +1,100 @@
+"""Compiled Newton-Euler equations of a rigid body on N elastic wires: the wires are force elements.
+
+State y (13) as in :mod:`bifilar.motion.nwire_kernel`: COM c (world, m), unit quaternion q (body ->
+world, scalar first), COM velocity v (world, m/s), angular velocity omega (world, rad/s). Per wire i:
+arm s_i = R r_i, span d_i = a_i - c - s_i, distance rho_i = |d_i|, direction u_i = d_i / rho_i, and
+
+    t_i = k_i max(0, rho_i - L_i),   k_i = EA_i / L_i   (a wire never pushes),
+
+    m v'       = -m g e_z + sum t_i u_i,
+    I_w omega' = -omega x I_w omega + sum s_i x t_i u_i,      I_w = R I_b R^T
+
+(docs/elastic-wires.md). No constraint, no multiplier: the tensions follow from the pose alone. With
+``[air]`` the fluid's added mass joins the mass matrix and its drag the applied wrench, exactly as in
+the inextensible kernel. The energy adds each wire's strain energy (k_i / 2) max(0, rho_i - L_i)^2.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from bifilar.motion.kane_kernel import P_AIR as AIR_FLAG
+from bifilar.motion.kane_kernel import air_terms
+from bifilar.motion.nwire_kernel import STATE_SIZE, _cross, quat_matrix
+
+
+@njit(cache=True)
+def dynamics(y, arms, anchors, lengths, springs, inertia_body, mass, gravity, air):
+    """(nu', tensions, stretch): accelerations (v', omega'), tensions (N) and rho_i - L_i (m) at y."""
+    n = arms.shape[0]
+    c, v, om = y[0:3], y[7:10], y[10:13]
+    rot = quat_matrix(y[3:7])
+    iw = rot @ inertia_body @ rot.T
+    f = np.zeros(6)
+    f[2] = -mass * gravity
+    f[3:] = -_cross(om, iw @ om)
+    tension = np.empty(n)
+    stretch = np.empty(n)
+    for i in range(n):
+        s = rot @ arms[i]
+        d = anchors[i] - c - s
+        rho = np.sqrt(d @ d)
+        stretch[i] = rho - lengths[i]
+        tension[i] = springs[i] * stretch[i] if stretch[i] > 0.0 else 0.0
+        pull = tension[i] * d / rho
+        f[:3] += pull
+        f[3:] += _cross(s, pull)
+    if air[AIR_FLAG] != 0.0:
+        maw, bias, drag = air_terms(rot, v, om, air)
+        m6 = maw.copy()
+        for k in range(3):
+            m6[k, k] += mass
+        m6[3:, 3:] += iw
+        acc = np.linalg.solve(m6, f + drag - bias)
+    else:
+        acc = np.empty(6)
+        acc[:3] = f[:3] / mass
+        acc[3:] = np.linalg.solve(iw, f[3:])
+    return acc, tension, stretch
+
+
+@njit(cache=True)
+def rhs(y, arms, anchors, lengths, springs, inertia_body, mass, gravity, air):
+    """y'; q' = (1/2) (0, omega) * q (world omega)."""
+    acc = dynamics(y, arms, anchors, lengths, springs, inertia_body, mass, gravity, air)[0]
+    q, om = y[3:7], y[10:13]
+    dy = np.empty(STATE_SIZE)
+    dy[0:3] = y[7:10]
+    dy[3] = -0.5 * (om[0] * q[1] + om[1] * q[2] + om[2] * q[3])
+    dy[4] = 0.5 * (om[0] * q[0] + om[1] * q[3] - om[2] * q[2])
+    dy[5] = 0.5 * (-om[0] * q[3] + om[1] * q[0] + om[2] * q[1])
+    dy[6] = 0.5 * (om[0] * q[2] - om[1] * q[1] + om[2] * q[0])
+    dy[7:13] = acc
+    return dy
+
+
+@njit(cache=True)
+def observe(Y, arms, anchors, lengths, springs, inertia_body, mass, gravity, air):
+    """Per sample: rotation matrix, tensions (N), stretch rho - L (m) and energy (J: kinetic, gravity
+    with zero at z = 0, strain; with air the fluid's kinetic energy)."""
+    n_s, n = Y.shape[0], arms.shape[0]
+    frames = np.empty((n_s, 3, 3))
+    ten = np.empty((n_s, n))
+    stretch = np.empty((n_s, n))
+    energy = np.empty(n_s)
+    for k in range(n_s):
+        y = Y[k]
+        rot = quat_matrix(y[3:7])
+        frames[k] = rot
+        _, ten[k], stretch[k] = dynamics(y, arms, anchors, lengths, springs, inertia_body, mass, gravity, air)
+        om, v = y[10:13], y[7:10]
+        iw = rot @ inertia_body @ rot.T
+        energy[k] = 0.5 * mass * (v @ v) + 0.5 * (om @ (iw @ om)) + mass * gravity * y[2]
+        for i in range(n):
+            if stretch[k, i] > 0.0:
+                energy[k] += 0.5 * springs[i] * stretch[k, i] ** 2
+        if air[AIR_FLAG] != 0.0:
+            x = np.concatenate((v, om))
+            energy[k] += 0.5 * (x @ (air_terms(rot, v, om, air)[0] @ x))
+    return frames, ten, stretch, energy
