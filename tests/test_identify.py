@@ -196,7 +196,8 @@ def main():
 
 
 FIELDS = {"period", "period_std", "inertia", "std", "interval95", "inertia_per_mass", "std_per_mass", "amplitude",
-          "damping", "amplitude_coefficient", "residual_rms", "outliers", "trials", "between_trial_std", "chi2_per_dof"}
+          "damping", "law", "halves", "rejected", "residual_rms", "outliers", "trials", "between_trial_std",
+          "chi2_per_dof"}
 BENCH = str(RIGS / "bench_plate.toml")
 
 
@@ -253,7 +254,7 @@ def test_cli_signal_about_a_swing_axis_uses_the_kane_series(main, capsys, tmp_pa
     path = torsion_csv(tmp_path, "x.csv", 0.3, 6, axis="x")
     out = run_json(main, capsys, BENCH, "--axis", "x", "--signal", path)
     trial = out["trials"][0]
-    assert trial["law"] == "series"
+    assert trial["law"]["kind"] == "series"
     assert abs(trial["inertia"] - ident.moment(rig("bench_plate"), "x")) < 3.0 * trial["std"]
 
 
@@ -335,7 +336,9 @@ def test_cli_record_that_cannot_be_used_names_it(main, capsys, tmp_path):
                header="t,angle", comments="")
     assert main(["identify", BENCH, "--axis", "z", "--signal", str(path)]) == 2
     err = capsys.readouterr().err
-    assert f"{path}: angle: no oscillation stands out of the noise" in err and err.count("\n") == 1
+    # pure noise: no cycle looks like the rig's (or, where a few do, nothing stands out of the noise)
+    assert f"{path}: angle: " in err and err.count("\n") == 1
+    assert "no oscillation stands out of the noise" in err or "cycles could be measured on their own" in err
 
 
 def test_png_is_written(main, capsys, tmp_path):
@@ -361,7 +364,7 @@ def test_cli_signal_of_a_trifilar_platform(main, capsys, tmp_path):
                comments="", fmt=["%d", "%.9f"])
     out = run_json(main, capsys, str(RIGS / "trifilar.toml"), "--axis", "z", "--signal", str(path), "--fps", "120")
     trial = out["trials"][0]
-    assert trial["law"] == "exact"
+    assert trial["law"]["kind"] == "exact"
     assert abs(trial["inertia"] - ident.moment(r, "z")) < 3.0 * trial["std"]
 
 
