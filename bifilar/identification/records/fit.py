@@ -748,38 +748,23 @@ class _Envelope:
     residual variance (an F test at ~3 sigma), at most :data:`_ENVELOPE_DEGREE`: as smooth as the decay
     the record shows and no smoother. Fitted to the amplitudes alone: let the phases move it and their
     noise would pass for a law through it (an error in the regressor attenuates what it regresses).
-    ``cov``: the coefficients' covariance, scaled by chi^2 per degree of freedom where that is above 1,
-    and a block sandwich where the amplitudes' errors are correlated from cycle to cycle (tracker noise
-    correlated over a cycle or more), if that is larger. Correlated errors also count as fewer
-    independent amplitudes in the F test (their integrated time, from the residual of the most
-    flexible fit): one cycle's error shared by its neighbours is not a wiggle of the decay."""
+    ``cov``: the coefficients' covariance, scaled by chi^2 per degree of freedom where that is above 1."""
 
     def __init__(self, t: np.ndarray, log_a: np.ndarray, sd: np.ndarray):
         self.t0, self.t1 = float(t[0]), float(t[-1])
         n = len(t)
-        top = min(_ENVELOPE_DEGREE, n - 2)
-        fits = []
-        for degree in range(0, top + 1):
+        best = None
+        for degree in range(0, min(_ENVELOPE_DEGREE, n - 2) + 1):
             x = self.basis(t, degree=degree) / sd[:, None]
             beta, *_ = np.linalg.lstsq(x, log_a / sd, rcond=None)
             r = log_a / sd - x @ beta
-            fits.append((degree, beta, float(r @ r), max(n - degree - 1, 1), x, r))
-        shared = _integrated_time(fits[-1][5])
-        best = fits[0]
-        for fit in fits[1:]:
-            if best[2] - fit[2] < _ENVELOPE_F * shared * fit[2] / fit[3]:
+            chi = float(r @ r)
+            dof = max(n - degree - 1, 1)
+            if best is not None and best[2] - chi < _ENVELOPE_F * chi / dof:
                 break
-            best = fit
-        self.degree, self.beta, chi, dof, x, r = best
-        bread = np.linalg.pinv(x.T @ x)
-        self.cov = bread * max(1.0, chi / dof)
-        block = _block_length(r)
-        if block > 1:
-            scores = np.add.reduceat(x * r[:, None], np.arange(0, n, block), axis=0)
-            nb = len(scores)
-            sandwich = bread @ (scores.T @ scores) @ bread * (nb / max(nb - 1, 1)) * (n / max(dof, 1))
-            if np.trace(sandwich) > np.trace(self.cov):
-                self.cov = sandwich
+            best = (degree, beta, chi, dof, x)
+        self.degree, self.beta, chi, dof, x = best
+        self.cov = np.linalg.pinv(x.T @ x) * max(1.0, chi / dof)
 
     def basis(self, t: np.ndarray, derivative: int = 0, degree: int | None = None) -> np.ndarray:
         from numpy.polynomial import chebyshev as C
@@ -825,26 +810,19 @@ def _few_blocks(nb: int) -> float:
     return (float(student_t.ppf(0.975, max(nb - 1, 1))) / float(norm.ppf(0.975))) ** 2
 
 
-def _integrated_time(r: np.ndarray) -> float:
-    """The integrated autocorrelation time of the series ``r`` in samples (initial positive sequence):
-    1 for independent values; how many of them count as one."""
+def _block_length(r: np.ndarray) -> int:
+    """:data:`BLOCK_TAUS` integrated autocorrelation times of ``r`` (initial positive sequence), at most
+    a fifth of the cycles (fewer blocks and their variance is itself too uncertain)."""
     n = len(r)
     if n < 10:
-        return 1.0
+        return 1
     x = r - r.mean()
     f = np.fft.rfft(x, 2 * n)
     acf = np.fft.irfft(f * np.conj(f))[:n]
-    acf = acf / max(acf[0], 1e-300)
+    acf = acf / acf[0]
     below = np.flatnonzero(acf < 0.0)
     stop = int(below[0]) if len(below) else n
-    return max(1.0, 1.0 + 2.0 * float(acf[1:stop].sum()))
-
-
-def _block_length(r: np.ndarray) -> int:
-    """:data:`BLOCK_TAUS` integrated autocorrelation times of ``r``, at most a fifth of the cycles
-    (fewer blocks and their variance is itself too uncertain)."""
-    n = len(r)
-    tau_int = _integrated_time(r)
+    tau_int = 1.0 + 2.0 * float(acf[1:stop].sum())
     return int(min(max(1, math.ceil(BLOCK_TAUS * tau_int)) if tau_int > 1.5 else 1, max(1, n // 5)))
 
 
