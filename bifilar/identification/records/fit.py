@@ -66,7 +66,11 @@ BLOCK_TAUS = 4.0  # batch-means block, in integrated autocorrelation times of th
 _WINDOW_SAMPLES = 12  # a window's terms (up to 9 with many samples a cycle) need residual degrees of freedom
 _WINDOW_GAP = 0.35  # largest gap inside a window, in windows: more and its terms are not orthogonal
 _BAD_RMS = 3.0  # a cycle's residual RMS above this times the record's median: not the rig's motion
-_FREQUENCY_STEPS = 2  # Gauss-Newton steps on a window's frequency: from 5 % off to ~1e-4 in two
+# ... and above this share of its own amplitude: a tracker that has not locked on writes values tens of
+# per cent off the swing, where what a window's model leaves of a clean large swing is below 1 %
+_LOCK_FLOOR = 0.02
+_SECOND_DECAY_SPANS = 4.0  # the most a second mode may decay over the record, in e-folds
+_FREQUENCY_STEPS = 3  # Gauss-Newton steps on a window's frequency and decay
 _FREQUENCY_RANGE = 0.05  # the largest relative step (a window's swing is within 5 % of the model's)
 _GLITCH_NEIGHBOURHOOD = 31  # samples (about half a cycle of a 60 fps video at 1 s): a glitch's scale
 _JUMP = math.log(1.5)  # a cycle's amplitude this far (in ln) from its neighbours' median: a jump
@@ -404,26 +408,39 @@ def _cycles(tau, y, usable, centres, omegas, decays, chirps, rate: bool) -> _Cyc
 
 
 def _window_fit(u: np.ndarray, y: np.ndarray, w: float, lam: float, harmonics: int, chirp: float):
-    """(frequency, design, terms) of one window's least squares with its frequency refined from ``w``
-    by Gauss-Newton (:data:`_FREQUENCY_STEPS` steps on the terms' joint linearisation): a window whose
-    swing is far from the model's (the first pass's single frequency, a cycle the model held from its
-    neighbours) would otherwise leave a residual that grows as its phase runs off the window's, and be
-    taken for a tracker that has not locked on. The phase at the centre, u = 0, does not depend on the
-    frequency to first order (a symmetric window), so refining it moves the residual, not the phase."""
-    for _ in range(_FREQUENCY_STEPS):
-        x = _basis(u, w, lam, harmonics, chirp)
+    """(frequency, design, terms) of one window's least squares with its frequency and decay refined
+    from ``w`` and ``lam`` by Gauss-Newton (:data:`_FREQUENCY_STEPS` steps on the terms' joint
+    linearisation, each kept only where it lowers the residual, the frequency within
+    :data:`_FREQUENCY_RANGE` of ``w``): a window whose swing is far from the model's (the first pass's
+    single frequency, a cycle the model held from its neighbours, a swing decaying faster than the
+    record's smoothed decay says) would otherwise leave a residual that grows as its phase runs off the
+    window's, and be taken for a tracker that has not locked on. The phase at the centre, u = 0, does
+    not depend on either to first order (a symmetric window), so refining them moves the residual, not
+    the phase."""
+    def solve(wf, lf):
+        x = _basis(u, wf, lf, harmonics, chirp)
         coef, *_ = np.linalg.lstsq(x, y, rcond=None)
-        phase = w * u + 0.5 * chirp * u * u
+        r = y - x @ coef
+        return x, coef, float(r @ r)
+
+    x, coef, best = solve(w, lam)
+    wf, lf = w, lam
+    for _ in range(_FREQUENCY_STEPS):
+        phase = wf * u + 0.5 * chirp * u * u
         slope = np.zeros(len(u))
         for j, n in enumerate(range(1, harmonics + 1, 2)):  # d (x @ coef) / d w
             a, b = coef[1 + 2 * j], coef[2 + 2 * j]
             slope += n * (b * np.cos(n * phase) - a * np.sin(n * phase))
-        slope *= u * np.exp(lam * u)
-        step = np.linalg.lstsq(np.column_stack([x, slope]), y - x @ coef, rcond=None)[0][-1]
-        w += float(np.clip(step, -_FREQUENCY_RANGE * w, _FREQUENCY_RANGE * w))
-    x = _basis(u, w, lam, harmonics, chirp)
-    coef, *_ = np.linalg.lstsq(x, y, rcond=None)
-    return w, x, coef
+        slope *= u * np.exp(lf * u)
+        grow = u * (x @ coef - coef[0])  # d (x @ coef) / d lam
+        step = np.linalg.lstsq(np.column_stack([x, slope, grow]), y - x @ coef, rcond=None)[0][-2:]
+        w_new = float(np.clip(wf + step[0], w * (1.0 - _FREQUENCY_RANGE), w * (1.0 + _FREQUENCY_RANGE)))
+        trial = solve(w_new, lf + float(step[1]))
+        if trial[2] >= best:
+            break
+        wf, lf = w_new, lf + float(step[1])
+        x, coef, best = trial
+    return wf, x, coef
 
 
 def _basis(u: np.ndarray, w: float, lam: float, harmonics: int, chirp: float = 0.0) -> np.ndarray:
@@ -460,7 +477,8 @@ def _mark(cyc: _Cycles) -> None:
             # against the record's and its neighbours' (a residual that grows smoothly with the swing, where
             # a clean record leaves what its harmonics do not hold, is not a tracker's)
             near = np.delete(cyc.rms[index[max(0, j - 5):j + 6]], min(j, 5))
-            if cyc.rms[k] > _BAD_RMS * max(median_rms, float(np.median(near)) if len(near) else 0.0):
+            if (cyc.rms[k] > _BAD_RMS * max(median_rms, float(np.median(near)) if len(near) else 0.0)
+                    and cyc.rms[k] > _LOCK_FLOOR * cyc.fundamental[k]):
                 good[k] = False
                 cyc.reason[k] = "residual far above the record's (tracker not locked on)"
         amp = np.log(np.where(good, cyc.fundamental, np.nan))
@@ -898,9 +916,14 @@ def _second_mode(rec: _Record, cyc: _Cycles, baseline: np.ndarray, model: _Model
         beta = np.linalg.lstsq(z, rest, rcond=None)[0]
         return rest - z @ beta, beta
 
-    sol = least_squares(lambda p: fitted(p)[0], [peak, 0.0], bounds=([0.0, 0.0], [np.inf, np.inf]),
+    # a mode beating in lasts the record (it decays by at most e^-SECOND_DECAY_SPANS over it) and is
+    # smaller than the first: a fast transient at the start fitted as one would take the first
+    # cycles' swing with it
+    sol = least_squares(lambda p: fitted(p)[0], [peak, 0.0], bounds=([0.0, 0.0], [np.inf, _SECOND_DECAY_SPANS / span]),
                         x_scale=[resolution, 1.0 / span], xtol=1e-10)
     c2, s2 = fitted(sol.x)[1]
+    if math.hypot(c2, s2) * math.exp(-sol.x[1] * tau[0]) > float(np.max(cyc.fundamental[good])):
+        return None
     return _Second(float(sol.x[0]), float(sol.x[1]), float(c2), float(s2))
 
 
@@ -960,9 +983,11 @@ def _whole(rec: _Record, cyc: _Cycles, model: _Model, baseline: np.ndarray, seco
         chirp = float(np.ptp(model.local_omega(cyc.centre[good])))
         peak = _peak_apart(tau, fit[2], fit[0][1], chirp)
         if peak is not None:
-            fit = _whole_fit(tau, y, u, integral, envelope, level, harmonics, list(fit[0][:4]),
-                             _Second(peak, 0.0, 0.0, 0.0))
-            second = _Second(peak, 0.0, 0.0, 0.0)
+            with_second = _whole_fit(tau, y, u, integral, envelope, level, harmonics, list(fit[0][:4]),
+                                     _Second(peak, 0.0, 0.0, 0.0))
+            c2, s2 = with_second[3][-2:]
+            if math.hypot(c2, s2) * math.exp(-with_second[0][5] * tau[0]) <= float(np.max(envelope)):
+                fit, second = with_second, _Second(peak, 0.0, 0.0, 0.0)
     q, jac, r, beta, model_y = fit
     n, k = jac.shape
     bread = np.linalg.pinv(jac.T @ jac)
@@ -1012,8 +1037,8 @@ def _whole_fit(tau, y, u, integral, envelope, level, harmonics, first, second):
     lo = np.full(len(start), -np.inf)
     hi = np.full(len(start), np.inf)
     lo[1], hi[1] = 0.9 * omega0, 1.1 * omega0
-    if second is not None:
-        lo[5] = 0.0
+    if second is not None:  # a mode beating in lasts the record (:func:`_second_mode`)
+        lo[5], hi[5] = 0.0, _SECOND_DECAY_SPANS / max(tau[-1] - tau[0], 1e-300)
     start = np.clip(np.array(start, dtype=float), lo, hi)
     sol = least_squares(residual, start, bounds=(lo, hi), x_scale="jac", xtol=1e-12, ftol=1e-12, gtol=1e-12)
     q = sol.x
