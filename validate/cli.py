@@ -70,7 +70,11 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--rerun", metavar="DIR", help="also write one rerun recording per case, DIR/<case>.rrd (default: none)")
     _report_options(p)
 
-    sub.add_parser("list", help="list the registered cases with their whole descriptions")
+    p = sub.add_parser("list", help="list the registered cases with their whole descriptions (--rigs: the shipped "
+                                    "rigs, sweeps and suspensions)", epilog=EPILOG)
+    p.add_argument("--rigs", action="store_true",
+                   help="list the shipped rig, sweep and suspension files instead, each with its name (which every "
+                        "command takes in place of the path) and a one-line description")
 
     p = sub.add_parser("case", help="run one case", epilog=EPILOG)
     p.add_argument("name", help="a case name from 'python -m validate list'")
@@ -128,6 +132,7 @@ def main(argv: list[str] | None = None) -> int:
         try:
             args = build_parser().parse_args(argv)
             args.argv = list(sys.argv[1:] if argv is None else argv)  # the command line, for the reports
+            _resolve_inputs(args)
             _check_outputs(args)
             code = _COMMANDS[args.command](args)
             sys.stdout.flush()
@@ -236,6 +241,23 @@ def _run_failed_line(exc: Exception, args) -> str:
         traceback.print_exception(exc)
     return (f"{source}: {_likely_field(exc)}: the {command} run failed ({what}); this field is the most likely "
             "cause (VALIDATE_TRACEBACK=1 shows where)")
+
+
+# Input file arguments -> the kind of shipped file a bare name means (validate.assets.resolve).
+_INPUTS = {"rig": "rig", "rigs": "rig", "tare": "rig", "space": "sweep", "suspension": "suspension"}
+
+
+def _resolve_inputs(args) -> None:
+    """Every input file argument through :func:`validate.assets.resolve`: a path that exists as given,
+    else a shipped file by name (``modes plate``, ``sweep bench_plate``) from any folder."""
+    from .assets import resolve
+
+    for name, kind in _INPUTS.items():
+        value = getattr(args, name, None)
+        if isinstance(value, str):
+            setattr(args, name, resolve(value, kind))
+        elif isinstance(value, list):
+            setattr(args, name, [resolve(v, kind) for v in value])
 
 
 def _check_outputs(args) -> None:
@@ -378,6 +400,8 @@ def _cmd_mjcf(args) -> int:
 def _cmd_list(args) -> int:
     import textwrap
 
+    if args.rigs:
+        return _list_shipped()
     from .suite import registered
 
     for c in registered(slow=True):
@@ -385,6 +409,20 @@ def _cmd_list(args) -> int:
         print(f"{c.name}  [{tags}]  {c.source}")
         text = " ".join(c.description.split())
         print(textwrap.fill(text, width=100, initial_indent="    ", subsequent_indent="    ") if text else "    -")
+    return OK
+
+
+def _list_shipped() -> int:
+    """``list --rigs``: per kind, one line per shipped file: its name and description."""
+    from .assets import KINDS, MODELS, description, shipped
+
+    for kind in KINDS:
+        files = shipped(kind)
+        folders = ", ".join(str(MODELS / f) for f in KINDS[kind])
+        print(f"{kind}s, in {folders}:")
+        width = max(map(len, files))
+        for name, path in files.items():
+            print(f"  {name:<{width}}  {description(path, width=96 - width)}")
     return OK
 
 
