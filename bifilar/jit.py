@@ -35,6 +35,7 @@ def use_user_cache() -> None:
 
 
 _announced: set[str] = set()
+EVERYTHING = "*"  # announced as ``what``: one note has covered every kernel (announce_modules)
 
 
 def announce_compile(what: str, *kernels, seconds: str = "30-80") -> None:
@@ -42,13 +43,20 @@ def announce_compile(what: str, *kernels, seconds: str = "30-80") -> None:
     note would repeat it per worker) if any of ``kernels`` (numba dispatchers with ``cache=True``) has
     no fresh cache entry, i.e. will be compiled at its first call. Call it just before the kernels'
     first use (it reads a small index file per kernel). ``seconds``: the estimate, on 2 cores."""
-    if what in _announced:
+    if what in _announced or EVERYTHING in _announced:
         return
     _announced.add(what)
     if any(not _cached(k) for k in kernels) and _main_process():
         where = os.environ.get("NUMBA_CACHE_DIR", "__pycache__ beside the sources")
         print(f"note: compiling {what} with numba (first run after an install or a change, ~{seconds} s; "
               f"cached afterwards in {where})", file=sys.stderr, flush=True)
+
+
+def announce_modules(what: str, modules, seconds: str) -> None:
+    """One note for every kernel of ``modules`` (see :func:`announce_compile`), after which no other
+    note is printed in this process: for a command that will use them all (``validate all``)."""
+    announce_compile(what, *[k for m in modules for k in _dispatchers(m).values()], seconds=seconds)
+    _announced.add(EVERYTHING)
 
 
 def _main_process() -> bool:
