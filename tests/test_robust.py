@@ -398,3 +398,12 @@ def test_a_kane_csv_that_stops_at_a_slack_wire_ends_with_no_pushing_wire(tmp_pat
     assert code == 3 and one_error(err).startswith(f"error: {path}: wire[1]: went slack at t = 0.0912")
     table = np.loadtxt(out, delimiter=",", skiprows=1)
     assert table[-1, 0] == pytest.approx(0.09) and table[:, 8:10].min() >= 0.0
+
+
+def test_the_rig_file_doc_states_the_wire_count_the_reader_accepts():
+    """The wire count of docs/rig-file.md is the reader's (2 .. MAX_WIRES), not "exactly two"."""
+    from bifilar.rig import ranges
+
+    doc = (ROOT / "docs" / "rig-file.md").read_text()
+    assert "exactly two [[wire]]" not in doc
+    assert f"2 to {ranges.MAX_WIRES} of them" in doc and f"| 2 .. {ranges.MAX_WIRES} (`MAX_WIRES`)" in doc
