@@ -407,3 +407,16 @@ def test_the_rig_file_doc_states_the_wire_count_the_reader_accepts():
     doc = (ROOT / "docs" / "rig-file.md").read_text()
     assert "exactly two [[wire]]" not in doc
     assert f"2 to {ranges.MAX_WIRES} of them" in doc and f"| 2 .. {ranges.MAX_WIRES} (`MAX_WIRES`)" in doc
+
+
+@pytest.mark.parametrize("verb", ["all", "list", "case", "modes", "simulate", "mjcf", "boat", "sweep"])
+def test_every_verbs_help_lists_exactly_its_exit_statuses(verb):
+    """One source (validate/statuses.py): each verb's --help lists the statuses it can return, no
+    others, within 100 columns (identify's help is its own module's)."""
+    from validate.statuses import COMMANDS
+
+    out = _cli(verb, "--help").stdout
+    block = out.split("exit status:\n")[1].split("\n\n")[0].splitlines()
+    listed = [int(line.split()[0]) for line in block if not line.startswith("       ")]
+    assert listed == sorted(COMMANDS[verb])
+    assert all(len(line) <= 100 for line in out.splitlines())
