@@ -1,16 +1,23 @@
-"""numba's on-disk cache kept out of the source tree, and one line on stderr when kernels compile.
+"""numba's on-disk cache kept out of the source tree, one line on stderr when kernels compile, and
+kernels that compile only when they loop.
 
 The Kane, TMT and signal kernels are compiled by numba with ``cache=True``. Left to itself numba writes
 its cache into ``__pycache__`` beside the sources (which fails silently in a read-only install, and
 litters a checkout); :func:`use_user_cache` points it at the user's cache folder instead, unless
 ``NUMBA_CACHE_DIR`` is already set. The first run after an install or a change of a kernel compiles for
 30-80 s; :func:`announce_compile` says so in one line instead of leaving the user in silence.
+
+One-shot work (one rig's rest pose and modes) need not wait for a compiler: :class:`LoopKernels`
+runs a kernel module's functions as plain Python (numpy) until they are either cached on disk or
+called often enough to be a loop (:data:`LOOP_CALLS`), and compiles them only then.
 """
 
 from __future__ import annotations
 
+import inspect
 import os
 import sys
+import types
 from pathlib import Path
 
 
@@ -28,19 +35,83 @@ def use_user_cache() -> None:
 
 
 _announced: set[str] = set()
+EVERYTHING = "*"  # announced as ``what``: one note has covered every kernel (announce_modules)
 
 
-def announce_compile(what: str, *kernels) -> None:
-    """One line on stderr (once per process and ``what``) if any of ``kernels`` (numba dispatchers with
-    ``cache=True``) has no fresh cache entry, i.e. will be compiled at its first call. Call it just
-    before the kernels' first use (it reads a small index file per kernel)."""
-    if what in _announced:
+def announce_compile(what: str, *kernels, seconds: str = "30-80") -> None:
+    """One line on stderr (once per process and ``what``, and only in the main process: a worker's
+    note would repeat it per worker) if any of ``kernels`` (numba dispatchers with ``cache=True``) has
+    no fresh cache entry, i.e. will be compiled at its first call. Call it just before the kernels'
+    first use (it reads a small index file per kernel). ``seconds``: the estimate, on 2 cores."""
+    if what in _announced or EVERYTHING in _announced:
         return
     _announced.add(what)
-    if any(not _cached(k) for k in kernels):
+    if any(not _cached(k) for k in kernels) and _main_process():
         where = os.environ.get("NUMBA_CACHE_DIR", "__pycache__ beside the sources")
-        print(f"note: compiling {what} with numba (first run after an install or a change: ~30-80 s; "
-              f"cached in {where})", file=sys.stderr, flush=True)
+        print(f"note: compiling {what} with numba (first run after an install or a change, ~{seconds} s; "
+              f"cached afterwards in {where})", file=sys.stderr, flush=True)
+
+
+def announce_modules(what: str, modules, seconds: str) -> None:
+    """One note for every kernel of ``modules`` (see :func:`announce_compile`), after which no other
+    note is printed in this process: for a command that will use them all (``validate all``)."""
+    announce_compile(what, *[k for m in modules for k in _dispatchers(m).values()], seconds=seconds)
+    _announced.add(EVERYTHING)
+
+
+def _main_process() -> bool:
+    import multiprocessing
+
+    return multiprocessing.parent_process() is None
+
+
+LOOP_CALLS = 200  # interpreted calls into one kernel module, per process, after which it is compiled
+
+
+class LoopKernels:
+    """A module of numba kernels, seen through the compile-only-what-loops policy: attribute access
+    gives the compiled function when the module's kernels are cached on disk (loading is quick), else
+    the module's plain-Python twin (:func:`interpreted`, the same code run by numpy) until
+    :data:`LOOP_CALLS` calls have been made through it in this process; then it compiles (announced
+    once, with ``seconds`` as the estimate) and gives the compiled functions from there on. Both run
+    the same source, so they agree to rounding."""
+
+    def __init__(self, module: types.ModuleType, what: str, seconds: str):
+        self._module, self._what, self._seconds = module, what, seconds
+        self._twin: types.ModuleType | None = None
+        self._compiled: bool | None = None  # None: the cache not looked at yet
+        self._calls = 0
+
+    def __getattr__(self, name: str):
+        if self._compiled is None:
+            self._compiled = all(_cached(k) for k in _dispatchers(self._module).values())
+        if not self._compiled:
+            self._calls += 1
+            if self._calls <= LOOP_CALLS:
+                if self._twin is None:
+                    self._twin = interpreted(self._module)
+                return getattr(self._twin, name)
+            announce_compile(self._what, *_dispatchers(self._module).values(), seconds=self._seconds)
+            self._compiled = True
+        return getattr(self._module, name)
+
+
+def _dispatchers(module: types.ModuleType) -> dict:
+    from numba.core.registry import CPUDispatcher
+
+    return {k: v for k, v in vars(module).items() if isinstance(v, CPUDispatcher) and v.__module__ == module.__name__}
+
+
+def interpreted(module: types.ModuleType) -> types.ModuleType:
+    """``module``'s plain-Python twin: its source run again in a new namespace, every kernel defined
+    there replaced by its Python function, so that kernels calling each other call the Python ones.
+    Nothing is compiled (defining a numba dispatcher is cheap; its first call compiles)."""
+    twin = types.ModuleType(f"{module.__name__}[interpreted]", module.__doc__)
+    twin.__file__ = module.__file__
+    exec(compile(inspect.getsource(module), module.__file__, "exec"), vars(twin))
+    for name, kernel in _dispatchers(twin).items():
+        setattr(twin, name, kernel.py_func)
+    return twin
 
 
 def _cached(kernel) -> bool:

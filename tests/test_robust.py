@@ -398,3 +398,25 @@ def test_a_kane_csv_that_stops_at_a_slack_wire_ends_with_no_pushing_wire(tmp_pat
     assert code == 3 and one_error(err).startswith(f"error: {path}: wire[1]: went slack at t = 0.0912")
     table = np.loadtxt(out, delimiter=",", skiprows=1)
     assert table[-1, 0] == pytest.approx(0.09) and table[:, 8:10].min() >= 0.0
+
+
+def test_the_rig_file_doc_states_the_wire_count_the_reader_accepts():
+    """The wire count of docs/rig-file.md is the reader's (2 .. MAX_WIRES), not "exactly two"."""
+    from bifilar.rig import ranges
+
+    doc = (ROOT / "docs" / "rig-file.md").read_text()
+    assert "exactly two [[wire]]" not in doc
+    assert f"2 to {ranges.MAX_WIRES} of them" in doc and f"| 2 .. {ranges.MAX_WIRES} (`MAX_WIRES`)" in doc
+
+
+@pytest.mark.parametrize("verb", ["all", "list", "case", "modes", "simulate", "mjcf", "boat", "sweep"])
+def test_every_verbs_help_lists_exactly_its_exit_statuses(verb):
+    """One source (validate/statuses.py): each verb's --help lists the statuses it can return, no
+    others, within 100 columns (identify's help is its own module's)."""
+    from validate.statuses import COMMANDS
+
+    out = _cli(verb, "--help").stdout
+    block = out.split("exit status:\n")[1].split("\n\n")[0].splitlines()
+    listed = [int(line.split()[0]) for line in block if not line.startswith("       ")]
+    assert listed == sorted(COMMANDS[verb])
+    assert all(len(line) <= 100 for line in out.splitlines())

@@ -24,26 +24,16 @@ from .argtypes import OneLineParser, UsageError, bounded_float, positive_float, 
 from .commands import boat as boat_cli
 from .commands import identify as identify_cli
 from .commands import sweep as sweep_cli
+from .statuses import BAD_INPUT, BROKEN_PIPE, INTERRUPTED, OK, RUN_FAILED, WENT_SLACK, epilog
 
-OK, CHECK_FAILED, BAD_INPUT, WENT_SLACK, RUN_FAILED, INTERRUPTED, BROKEN_PIPE = 0, 1, 2, 3, 4, 130, 141
+EPILOG = epilog(examples=(
+    "python -m validate modes models/rigs/plate.toml",
+    "python -m validate modes plate                      # a shipped rig by name (list --rigs)",
+    "python -m validate simulate models/rigs/plate.toml --engine kane --duration 60 --out plate.csv",
+    "python -m validate all -k torsion",
+))
 
-EPILOG = """\
-exit status:
-  0    success
-  1    a validation check failed (all, case)
-  2    bad input: one line on stderr naming the file (or option), the field and the problem
-  3    a wire went slack and the taut-wire Kane model stopped there (simulate; the CSV ends there)
-  4    a run that failed: a numerical failure inside the physics or a spent work budget (one line
-       naming the field most likely responsible)
-  130  interrupted (Ctrl-C)
-  141  the reader of stdout went away (e.g. '| head'); nothing more is printed
-
-examples:
-  python -m validate modes models/rigs/plate.toml
-  python -m validate simulate models/rigs/plate.toml --engine kane --duration 60 --out plate.csv
-  python -m validate all -k torsion
-"""
-
+RIG_HELP = "rig file (TOML), or the name of a shipped rig, e.g. plate ('python -m validate list --rigs')"
 MAX_DURATION = 1e5  # s: the longest simulation one command runs (27 hours of swinging)
 RTOL_RANGE = (1e-13, 1e-4)  # below: DOP853 is at rounding; above: the energy drifts by percent per period
 
@@ -57,7 +47,8 @@ def build_parser() -> argparse.ArgumentParser:
                            epilog=EPILOG)
     sub = parser.add_subparsers(dest="command", required=True, parser_class=OneLineParser, metavar="COMMAND")
 
-    p = sub.add_parser("all", help="run every registered validation case", epilog=EPILOG)
+    p = sub.add_parser("all", help="run every registered validation case", epilog=epilog("all", (
+        "python -m validate all --json report.json --rerun recordings/", "python -m validate all -k torsion")))
     p.add_argument("--json", metavar="REPORT.json", help="also write the report as JSON (default: none)")
     p.add_argument("--slow", action="store_true", help="include cases tagged slow (default: fast cases only); with "
                                                         "--html, also the stored result of benchmarks/speed_accuracy.py")
@@ -70,21 +61,31 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--rerun", metavar="DIR", help="also write one rerun recording per case, DIR/<case>.rrd (default: none)")
     _report_options(p)
 
-    sub.add_parser("list", help="list the registered cases with their whole descriptions")
+    p = sub.add_parser("list", help="list the registered cases with their whole descriptions (--rigs: the shipped "
+                                    "rigs, sweeps and suspensions)",
+                       epilog=epilog("list", ("python -m validate list", "python -m validate list --rigs")))
+    p.add_argument("--rigs", action="store_true",
+                   help="list the shipped rig, sweep and suspension files instead, each with its name (which every "
+                        "command takes in place of the path) and a one-line description")
 
-    p = sub.add_parser("case", help="run one case", epilog=EPILOG)
+    p = sub.add_parser("case", help="run one case", epilog=epilog("case", (
+        "python -m validate case rig-torsion-6.2 --rerun torsion.rrd",)))
     p.add_argument("name", help="a case name from 'python -m validate list'")
     p.add_argument("--json", metavar="REPORT.json", help="also write the report as JSON (default: none)")
     p.add_argument("--rerun", metavar="FILE.rrd",
                    help="also write a rerun recording of the case, open with: rerun FILE.rrd (default: none)")
     _report_options(p)
 
-    p = sub.add_parser("modes", help="rest pose, static tensions and small-oscillation periods", epilog=EPILOG)
-    p.add_argument("rig", help="rig file (TOML), e.g. models/rigs/plate.toml")
-    p.add_argument("--json", action="store_true", help="print one JSON object instead of text")
+    p = sub.add_parser("modes", help="rest pose, static tensions and small-oscillation periods",
+                       epilog=epilog("modes", ("python -m validate modes plate", "python -m validate modes my_rig.toml --json")))
+    p.add_argument("rig", help=RIG_HELP)
+    p.add_argument("--json", action="store_true",
+                   help="print one JSON object (COM m, rotation, tensions N, periods s, frequencies Hz, omega^2 "
+                        "rad^2/s^2, mode shapes m and rad; world frame) instead of text (default: text)")
 
-    p = sub.add_parser("simulate", help="simulate a rig and write the trajectory CSV", epilog=EPILOG)
-    p.add_argument("rig", help="rig file (TOML); the run starts from its [initial] disturbance")
+    p = sub.add_parser("simulate", help="simulate a rig and write the trajectory CSV", epilog=epilog("simulate", (
+        "python -m validate simulate plate --engine kane --duration 60 --out plate.csv",)))
+    p.add_argument("rig", help=RIG_HELP + "; the run starts from its [initial] disturbance")
     p.add_argument("--engine", default="kane", choices=ENGINE_NAMES,
                    help="kane: the hand-derived model (Kane-Tseng for two wires, the N-wire model otherwise; "
                         "stops where a wire goes slack); nwire: the N-wire model on any rig; mujoco: tendon "
@@ -103,13 +104,16 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--rerun", metavar="FILE.rrd", help="also write a rerun recording of the run (default: none)")
 
     p = sub.add_parser("mjcf", help="write MuJoCo models of rigs: DIR/<rig>/<rig>.xml and DIR/<rig>/scene.xml",
-                       epilog=EPILOG)
-    p.add_argument("rigs", nargs="+", metavar="RIG", help="rig files (TOML); their names must differ")
+                       epilog=epilog("mjcf", ("python -m validate mjcf asymmetric plate --out out/",)))
+    p.add_argument("rigs", nargs="+", metavar="RIG", help="rig files (TOML) or shipped rigs' names ('list --rigs'); "
+                                                         "their names must differ")
     p.add_argument("--out", required=True, metavar="DIR", help="folder that receives one folder per rig name")
 
     identify_cli.add_parser(sub)
     boat_cli.add_parser(sub)
     sweep_cli.add_parser(sub)
+    sweep = sub.choices["sweep"]
+    sweep.epilog = sweep.epilog or epilog("sweep", ("python -m validate sweep bench_plate --out sweep/ --png",))
     return parser
 
 
@@ -128,6 +132,7 @@ def main(argv: list[str] | None = None) -> int:
         try:
             args = build_parser().parse_args(argv)
             args.argv = list(sys.argv[1:] if argv is None else argv)  # the command line, for the reports
+            _resolve_inputs(args)
             _check_outputs(args)
             code = _COMMANDS[args.command](args)
             sys.stdout.flush()
@@ -237,6 +242,23 @@ def _run_failed_line(exc: Exception, args) -> str:
         traceback.print_exception(exc)
     return (f"{source}: {_likely_field(exc)}: the {command} run failed ({what}); this field is the most likely "
             "cause (VALIDATE_TRACEBACK=1 shows where)")
+
+
+# Input file arguments -> the kind of shipped file a bare name means (validate.assets.resolve).
+_INPUTS = {"rig": "rig", "rigs": "rig", "tare": "rig", "space": "sweep", "suspension": "suspension"}
+
+
+def _resolve_inputs(args) -> None:
+    """Every input file argument through :func:`validate.assets.resolve`: a path that exists as given,
+    else a shipped file by name (``modes plate``, ``sweep bench_plate``) from any folder."""
+    from .assets import resolve
+
+    for name, kind in _INPUTS.items():
+        value = getattr(args, name, None)
+        if isinstance(value, str):
+            setattr(args, name, resolve(value, kind))
+        elif isinstance(value, list):
+            setattr(args, name, [resolve(v, kind) for v in value])
 
 
 def _check_outputs(args) -> None:
@@ -386,6 +408,8 @@ def _cmd_mjcf(args) -> int:
 def _cmd_list(args) -> int:
     import textwrap
 
+    if args.rigs:
+        return _list_shipped()
     from .suite import registered
 
     for c in registered(slow=True):
@@ -393,6 +417,20 @@ def _cmd_list(args) -> int:
         print(f"{c.name}  [{tags}]  {c.source}")
         text = " ".join(c.description.split())
         print(textwrap.fill(text, width=100, initial_indent="    ", subsequent_indent="    ") if text else "    -")
+    return OK
+
+
+def _list_shipped() -> int:
+    """``list --rigs``: per kind, one line per shipped file: its name and description."""
+    from .assets import KINDS, MODELS, description, shipped
+
+    for kind in KINDS:
+        files = shipped(kind)
+        folders = ", ".join(str(MODELS / f) for f in KINDS[kind])
+        print(f"{kind}s, in {folders}:")
+        width = max(map(len, files))
+        for name, path in files.items():
+            print(f"  {name:<{width}}  {description(path, width=96 - width)}")
     return OK
 
 

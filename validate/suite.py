@@ -17,6 +17,9 @@ from typing import Callable, Sequence
 
 from .registry import REGISTRY, Case, CaseContext, Metric
 
+# The compile time of every kernel the cases use, empty cache, 2 cores (benchmarks/first_run.py).
+COMPILE_SECONDS = "60-120"
+
 
 @dataclass
 class CaseResult:
@@ -101,6 +104,19 @@ def run_case(name: str, keep_trajectories: bool = False, keep_traces: bool = Fal
                       c.run.__module__.rsplit(".", 1)[-1], list(ctx.notes), traces)
 
 
+def _announce_compile() -> None:
+    """One note, here in the main process, if the cases' kernels will compile (the workers keep quiet)."""
+    from bifilar import jit, smallmat
+    from bifilar.identification import slopes_kernel
+    from bifilar.motion import kane_kernel, nwire_kernel
+    from bifilar.rig import pose_kernel
+    from bifilar.seeds import tmt
+    from bifilar.sweep import kernel as sweep_kernel
+
+    modules = (smallmat, kane_kernel, nwire_kernel, tmt, pose_kernel, slopes_kernel, sweep_kernel)
+    jit.announce_modules("the Kane, N-wire, TMT and pose kernels", modules, seconds=COMPILE_SECONDS)
+
+
 def run_cases(cases: list[Case], jobs: int = 2, json_path: str | None = None,
               on_result: Callable[[CaseResult], object] | None = None, progress: bool = False,
               reports: Sequence[Report] = (), traces: bool = False) -> int:
@@ -111,6 +127,7 @@ def run_cases(cases: list[Case], jobs: int = 2, json_path: str | None = None,
     each case is announced on stderr as it finishes, with its verdict and wall time."""
     names = [c.name for c in cases]
     keep = on_result is not None
+    _announce_compile()
     start = time.perf_counter()
     done: dict[str, CaseResult] = {}
 

@@ -37,8 +37,7 @@ from scipy.linalg import eigh
 from bifilar.bodies.air import added_mass
 from bifilar.rig import Rig
 from bifilar.rig import elastic
-from bifilar.rig import pose_kernel as PK
-from bifilar.rig.statics import NULL_RTOL, Rest, State, anchors, arms, rest_pose, rig_scale
+from bifilar.rig.statics import NULL_RTOL, PK, Rest, State, anchors, arms, rest_pose, rig_scale
 
 NEUTRAL_RTOL = 1e-9  # an eigenvalue below this fraction of the largest is neutral (or unstable)
 DEGENERATE_RTOL = 1e-9  # eigenvalues closer than this fraction of the largest are one frequency

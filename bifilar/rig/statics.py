@@ -25,8 +25,12 @@ import numpy as np
 from scipy.optimize import least_squares, minimize
 from scipy.spatial.transform import Rotation
 
-from bifilar.rig import Rig, RigError
-from bifilar.rig import pose_kernel as PK
+from bifilar.jit import LoopKernels
+from bifilar.rig import Rig, RigError, pose_kernel
+
+# The pose kernels (also for modes.py): one rig's rest pose and modes in plain Python, compiled once
+# they loop (bifilar.jit.LoopKernels).
+PK = LoopKernels(pose_kernel, "the pose kernels", seconds="10-30")
 
 # Newton on the equilibrium equations converges quadratically: 30 iterations is ample from any start
 # SLSQP hands it; a residual of 1e-12 (forces / weight, lengths / rig size) is machine precision on

@@ -25,11 +25,19 @@ COLOURS = ((31, 119, 180), (255, 127, 14), (44, 160, 44), (148, 103, 189), (140,
 
 def add_parser(subparsers):
     """Add the ``boat`` command to ``python -m validate``'s subparsers."""
-    p = subparsers.add_parser("boat", help="the Solar Boat study (thesis ch. 8): moments, tensions, clearance")
+    from ..statuses import epilog
+
+    p = subparsers.add_parser("boat", help="the Solar Boat study (thesis ch. 8): moments, tensions, clearance",
+                              epilog=epilog("boat", ("python -m validate boat --png docs/boat_tensions.png",)))
     p.add_argument("--suspension", metavar="FILE.toml",
-                   help="hall, configurations and measurement errors (default: models/solar_boat/suspension.toml)")
-    p.add_argument("--json", action="store_true", help="print one JSON object")
-    p.add_argument("--png", metavar="FILE.png", help="also draw the wire tensions of every configuration")
+                   help="hall, configurations and measurement errors: a file or a shipped suspension's name "
+                        "('list --rigs') (default: models/solar_boat/suspension.toml)")
+    p.add_argument("--json", action="store_true",
+                   help="print one JSON object instead of the text tables (moments kg m^2, tensions N, depths m; "
+                        "default: text)")
+    p.add_argument("--png", metavar="FILE.png",
+                   help=f"also draw the wire tensions (N) of every configuration over {FIGURE_SECONDS:g} s of each "
+                        "motion (default: no figure)")
     return p
 
 
