@@ -298,7 +298,7 @@ def test_help_lists_exit_codes_an_example_and_option_units():
                  "python -m validate modes models/rigs/plate.toml"):
         assert text in proc.stdout, text
     sim = _cli("simulate", "--help").stdout
-    for text in ("{kane,nwire,mujoco,mujoco-eq}", "simulated time, s", "(default: 0.01)", "(default: 1e-10",
+    for text in ("{kane,nwire,mujoco,mujoco-eq,mujoco-cable}", "simulated time, s", "(default: 0.01)", "(default: 1e-10",
                  "wall-time budget of the run, s"):
         assert text in " ".join(sim.split()), text
 

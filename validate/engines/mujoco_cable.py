@@ -49,6 +49,7 @@ MAX_STEPS = 5_000_000
 SOLREF_STEPS = 2  # the connect rows' time constant in steps, damping ratio DAMPRATIO (the rig engine's choice)
 DAMPRATIO = 0.5
 INTEGRATOR = "implicitfast"
+IMPEDANCE = 0.9999  # solimp d of the connect rows
 
 
 def run(rig: Rig, duration: float, dt_out: float = 0.01, rtol: float = 1e-10, state: State | None = None, *,
@@ -117,7 +118,7 @@ def _mjcf(rig: Rig, state: State, segments: int, timestep: float) -> str:
             close += "</body>"
         chains.append(xml + close)
         equalities.append(f'<connect body1="w{i + 1}s{segments - 1}" body2="body" anchor="{fmt(seg)}" '
-                          f'solref="{SOLREF_STEPS * timestep:.17g} {DAMPRATIO:g}" solimp="0.99 0.99 0.001 0.5 2"/>')
+                          f'solref="{SOLREF_STEPS * timestep:.17g} {DAMPRATIO:g}" solimp="{IMPEDANCE:g} {IMPEDANCE:g} 0.001 0.5 2"/>')
     return (f'<mujoco model="{rig.name}_cable"><compiler angle="radian" inertiafromgeom="false"/>'
             f'<option timestep="{timestep:.17g}" integrator="{INTEGRATOR}" gravity="0 0 {-rig.gravity:.17g}" tolerance="1e-10">'
             f'<flag energy="enable" contact="disable"/></option>'
