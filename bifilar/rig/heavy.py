@@ -28,7 +28,7 @@ from bifilar.rig import Rig
 from bifilar.rig import pose_kernel as PK
 from bifilar.rig.statics import NULL_RTOL, Rest, anchors, arms, rest_pose, rig_scale
 
-__all__ = ["wire_masses", "has_wire_mass", "massless", "lumped", "body_end_tensions", "system"]
+__all__ = ["wire_masses", "has_wire_mass", "massless", "lumped", "body_end_tensions", "system", "with_mass_ratio"]
 
 
 def wire_masses(rig: Rig) -> np.ndarray:
@@ -96,3 +96,10 @@ def system(rig: Rig, guess: Rest | None = None) -> tuple[Rest, np.ndarray, np.nd
     z[:3] -= PK.cross_matrix(offset) @ z[3:]  # the body COM moves with x - [d]x theta
     tensions = body_end_tensions(rig, body_com, rest.rotation, rest.tensions)
     return Rest(body_com, rest.rotation, tensions), z, kinetic_matrix(rig, rest.rotation), kr
+
+
+def with_mass_ratio(rig: Rig, ratio: float) -> Rig:
+    """``rig`` with every wire of one linear density, chosen so that the wires together weigh
+    ``ratio`` times the body: rho = ratio m / sum L_i (kg/m)."""
+    density = ratio * rig.mass / sum(w.length for w in rig.wires)
+    return replace(rig, wires=tuple(replace(w, linear_density=density) for w in rig.wires))

@@ -50,6 +50,7 @@ SOLREF_STEPS = 2  # the connect rows' time constant in steps, damping ratio DAMP
 DAMPRATIO = 0.5
 INTEGRATOR = "implicitfast"
 IMPEDANCE = 0.9999  # solimp d of the connect rows
+SETTLE = 10.0  # decay times of the wires' first transverse mode the chains settle for before the release
 
 
 def run(rig: Rig, duration: float, dt_out: float = 0.01, rtol: float = 1e-10, state: State | None = None, *,
@@ -70,8 +71,24 @@ def run(rig: Rig, duration: float, dt_out: float = 0.01, rtol: float = 1e-10, st
     start = body_state(rig) if state is None else state
     model = compile_model(rig, start, segments, timestep)
     data = mujoco.MjData(model)
-    data.qvel[:] = initial_qvel(rig, start, model)
+    settle(model, data, rig)
+    data.qvel[:] = initial_qvel(rig, start, model, data)
     return _sample(model, data, rig, times, nstep, dt_out, max_seconds)
+
+
+def settle(model: mujoco.MjModel, data: mujoco.MjData, rig: Rig) -> None:
+    """Let every chain sag into its rest shape with the body held at its start pose by the ``hold``
+    weld: :data:`SETTLE` decay times 1 / (zeta omega_1) of the slowest wire's first transverse mode,
+    then the weld is released, the chains' velocities zeroed and the clock reset."""
+    decay = max(1.0 / (BEND_DAMPING * first_mode(rig, i)) for i in range(len(rig.wires)))
+    hold = model.equality("hold").id
+    data.eq_active[hold] = 1
+    with _quiet_warnings():
+        mujoco.mj_step(model, data, int(np.ceil(SETTLE * decay / model.opt.timestep)))
+    _check_warnings(data, 0.0)
+    data.eq_active[hold] = 0
+    data.qvel[:] = 0.0
+    data.time = 0.0
 
 
 def body_state(rig: Rig) -> State:
@@ -119,6 +136,8 @@ def _mjcf(rig: Rig, state: State, segments: int, timestep: float) -> str:
         chains.append(xml + close)
         equalities.append(f'<connect body1="w{i + 1}s{segments - 1}" body2="body" anchor="{fmt(seg)}" '
                           f'solref="{SOLREF_STEPS * timestep:.17g} {DAMPRATIO:g}" solimp="{IMPEDANCE:g} {IMPEDANCE:g} 0.001 0.5 2"/>')
+    equalities.append(f'<weld name="hold" body1="body" active="false" solref="{SOLREF_STEPS * timestep:.17g} '
+                      f'{DAMPRATIO:g}" solimp="{IMPEDANCE:g} {IMPEDANCE:g} 0.001 0.5 2"/>')
     return (f'<mujoco model="{rig.name}_cable"><compiler angle="radian" inertiafromgeom="false"/>'
             f'<option timestep="{timestep:.17g}" integrator="{INTEGRATOR}" gravity="0 0 {-rig.gravity:.17g}" tolerance="1e-10">'
             f'<flag energy="enable" contact="disable"/></option>'
@@ -136,10 +155,14 @@ def bend_damping(rig: Rig, wire: int, segments: int) -> float:
     wire's first transverse mode (a string under t ~ m g / n_wires), i.e. 2 zeta omega_1 m_s l^2 / 3
     with the segment's mass m_s and length l (its inertia about its joint)."""
     w = rig.wires[wire]
-    tension = rig.mass * rig.gravity / len(rig.wires)
-    omega1 = np.pi * np.sqrt(tension / w.linear_density) / w.length
     segment = w.length / segments
-    return 2.0 * BEND_DAMPING * omega1 * (w.linear_density * segment) * segment**2 / 3.0
+    return 2.0 * BEND_DAMPING * first_mode(rig, wire) * (w.linear_density * segment) * segment**2 / 3.0
+
+
+def first_mode(rig: Rig, wire: int) -> float:
+    """omega_1 (rad/s) of a wire's first transverse mode, pi sqrt(t / rho) / L, with t ~ m g / n_wires."""
+    w = rig.wires[wire]
+    return float(np.pi * np.sqrt(rig.mass * rig.gravity / len(rig.wires) / w.linear_density) / w.length)
 
 
 def compile_model(rig: Rig, state: State, segments: int = SEGMENTS, timestep: float = TIMESTEP) -> mujoco.MjModel:
@@ -147,10 +170,11 @@ def compile_model(rig: Rig, state: State, segments: int = SEGMENTS, timestep: fl
     return mujoco.MjModel.from_xml_string(_mjcf(rig, state, segments, timestep))
 
 
-def initial_qvel(rig: Rig, state: State, model: mujoco.MjModel) -> np.ndarray:
+def initial_qvel(rig: Rig, state: State, model: mujoco.MjModel, data: mujoco.MjData) -> np.ndarray:
     """Velocities: the body's free joint (origin velocity, world; angular velocity, body axes) and each
-    wire's anchor joint turning the straight wire with its attachment, omega = span x v_p / |span|^2
-    (the inner joints at rest relative to it; every body frame is world-aligned at the start)."""
+    wire's anchor joint turning the settled chain rigidly about its anchor with the attachment's
+    velocity, omega = span x v_p / |span|^2 (a ball joint's velocity is in its body's frame; the inner
+    joints at rest relative to it)."""
     qvel = np.zeros(model.nv)
     arm = state.rotation @ rig.com
     qvel[:3] = state.velocity - np.cross(state.omega, arm)
@@ -160,7 +184,8 @@ def initial_qvel(rig: Rig, state: State, model: mujoco.MjModel) -> np.ndarray:
         v_p = state.velocity + np.cross(state.omega, s)
         span = state.com + s - w.anchor
         dof = model.jnt_dofadr[model.body_jntadr[model.body(f"w{i + 1}s0").id]]
-        qvel[dof:dof + 3] = np.cross(span, v_p) / (span @ span)
+        frame = data.xmat[model.body(f"w{i + 1}s0").id].reshape(3, 3)
+        qvel[dof:dof + 3] = frame.T @ (np.cross(span, v_p) / (span @ span))
     return qvel
 
 
