@@ -26,7 +26,7 @@ from ..registry import CaseContext, case, check
 RATIOS = (0.001, 0.01, 0.05, 0.1)
 AMPLITUDE = 1e-4  # rad: the plate's own amplitude shift is 7.4e-7 at 1e-3 rad (measured), ~7e-9 here
 PERIODS = 3.0  # periods of each chain run
-SEGMENTS = 8  # per wire (docs/heavy-wires.md: 4, 8 and 16 segments differ by < 4e-6 at ratio 0.1)
+SEGMENTS = 8  # per wire; 16 moves the ratio-0.01 residual by 7e-7 of its 8e-6 (docs/heavy-wires.md)
 # The chain against the first-order model: second order in the ratio, measured 0.065-0.085 ratio^2 on
 # the plate (docs/heavy-wires.md), held at 0.15 ratio^2; plus the chain's numerical floor, 1e-7 (a
 # one-segment chain, a rigid rod, which the first-order model describes exactly, agrees to 3e-9;

@@ -20,9 +20,12 @@ damping that takes them out within a few of their periods without touching a str
 of the wire on the body at its end; ``length_error`` is the anchor-attachment distance minus the
 wire's length (the sag makes it slightly negative); ``energy`` is MuJoCo's, body and chains.
 
-Numerics: RK4 at :data:`TIMESTEP` (its stability limit omega h < 2.8 holds the chain's fastest mode
-for the rigs of tests and cases: omega ~ 2 N sqrt(t / rho) / L), connect rows with the rig engine's
-solref (2 h, 0.5) and solimp d = 0.99 (validate/engines/mjcf.py).
+Numerics: MuJoCo's implicitfast at :data:`TIMESTEP` (the chain's fastest mode, omega ~ 2 N sqrt(t /
+rho) / L, is ~2e3 rad/s for the rigs of tests and cases: omega h ~ 0.2), connect rows with the rig
+engine's solref (2 h, 0.5) and solimp d = 0.9999 (:data:`IMPEDANCE`: at the rig engine's 0.99 the
+rows, tied to a light segment, stretched 4.5e-7 m on the parallel rig and cost 1.5e-6 in the period;
+RK4 at 1e-4 s went unstable). Velocities are those of the step, not staggered as in
+:mod:`validate.engines.mujoco_rig`: a period is insensitive to that half step.
 """
 
 from __future__ import annotations
@@ -50,7 +53,6 @@ SOLREF_STEPS = 2  # the connect rows' time constant in steps, damping ratio DAMP
 DAMPRATIO = 0.5
 INTEGRATOR = "implicitfast"
 IMPEDANCE = 0.9999  # solimp d of the connect rows
-SETTLE = 10.0  # decay times of the wires' first transverse mode the chains settle for before the release
 
 
 def run(rig: Rig, duration: float, dt_out: float = 0.01, rtol: float = 1e-10, state: State | None = None, *,
@@ -71,24 +73,8 @@ def run(rig: Rig, duration: float, dt_out: float = 0.01, rtol: float = 1e-10, st
     start = body_state(rig) if state is None else state
     model = compile_model(rig, start, segments, timestep)
     data = mujoco.MjData(model)
-    settle(model, data, rig)
-    data.qvel[:] = initial_qvel(rig, start, model, data)
+    data.qvel[:] = initial_qvel(rig, start, model)
     return _sample(model, data, rig, times, nstep, dt_out, max_seconds)
-
-
-def settle(model: mujoco.MjModel, data: mujoco.MjData, rig: Rig) -> None:
-    """Let every chain sag into its rest shape with the body held at its start pose by the ``hold``
-    weld: :data:`SETTLE` decay times 1 / (zeta omega_1) of the slowest wire's first transverse mode,
-    then the weld is released, the chains' velocities zeroed and the clock reset."""
-    decay = max(1.0 / (BEND_DAMPING * first_mode(rig, i)) for i in range(len(rig.wires)))
-    hold = model.equality("hold").id
-    data.eq_active[hold] = 1
-    with _quiet_warnings():
-        mujoco.mj_step(model, data, int(np.ceil(SETTLE * decay / model.opt.timestep)))
-    _check_warnings(data, 0.0)
-    data.eq_active[hold] = 0
-    data.qvel[:] = 0.0
-    data.time = 0.0
 
 
 def body_state(rig: Rig) -> State:
@@ -136,8 +122,6 @@ def _mjcf(rig: Rig, state: State, segments: int, timestep: float) -> str:
         chains.append(xml + close)
         equalities.append(f'<connect body1="w{i + 1}s{segments - 1}" body2="body" anchor="{fmt(seg)}" '
                           f'solref="{SOLREF_STEPS * timestep:.17g} {DAMPRATIO:g}" solimp="{IMPEDANCE:g} {IMPEDANCE:g} 0.001 0.5 2"/>')
-    equalities.append(f'<weld name="hold" body1="body" active="false" solref="{SOLREF_STEPS * timestep:.17g} '
-                      f'{DAMPRATIO:g}" solimp="{IMPEDANCE:g} {IMPEDANCE:g} 0.001 0.5 2"/>')
     return (f'<mujoco model="{rig.name}_cable"><compiler angle="radian" inertiafromgeom="false"/>'
             f'<option timestep="{timestep:.17g}" integrator="{INTEGRATOR}" gravity="0 0 {-rig.gravity:.17g}" tolerance="1e-10">'
             f'<flag energy="enable" contact="disable"/></option>'
@@ -170,11 +154,11 @@ def compile_model(rig: Rig, state: State, segments: int = SEGMENTS, timestep: fl
     return mujoco.MjModel.from_xml_string(_mjcf(rig, state, segments, timestep))
 
 
-def initial_qvel(rig: Rig, state: State, model: mujoco.MjModel, data: mujoco.MjData) -> np.ndarray:
+def initial_qvel(rig: Rig, state: State, model: mujoco.MjModel) -> np.ndarray:
     """Velocities: the body's free joint (origin velocity, world; angular velocity, body axes) and each
-    wire's anchor joint turning the settled chain rigidly about its anchor with the attachment's
-    velocity, omega = span x v_p / |span|^2 (a ball joint's velocity is in its body's frame; the inner
-    joints at rest relative to it)."""
+    wire's anchor joint turning the straight chain rigidly about its anchor with the attachment's
+    velocity, omega = span x v_p / |span|^2 (the inner joints at rest relative to it; every body frame
+    is world-aligned at the start)."""
     qvel = np.zeros(model.nv)
     arm = state.rotation @ rig.com
     qvel[:3] = state.velocity - np.cross(state.omega, arm)
@@ -184,8 +168,7 @@ def initial_qvel(rig: Rig, state: State, model: mujoco.MjModel, data: mujoco.MjD
         v_p = state.velocity + np.cross(state.omega, s)
         span = state.com + s - w.anchor
         dof = model.jnt_dofadr[model.body_jntadr[model.body(f"w{i + 1}s0").id]]
-        frame = data.xmat[model.body(f"w{i + 1}s0").id].reshape(3, 3)
-        qvel[dof:dof + 3] = frame.T @ (np.cross(span, v_p) / (span @ span))
+        qvel[dof:dof + 3] = np.cross(span, v_p) / (span @ span)
     return qvel
 
 
