@@ -53,9 +53,9 @@ def chain_yaw_period(r, segments: int = SEGMENTS):
 @case("heavy-wires-plate", source="issue 20 item 4 (heavy wires)", engines=("modes", "mujoco-cable"),
       tags=("slow",))
 def heavy_plate(ctx: CaseContext):
-    """Thesis plate in yaw on wires weighing 0.1 % .. 10 % of the body: the massless and the
-    first-order periods against MuJoCo's chain cable, and the ratio below which the massless error
-    is < 1e-4."""
+    """Thesis plate in yaw on wires weighing 0.1 % .. 10 % of the body: the massless periods and those
+    corrected to first order in the wire mass against MuJoCo's chain cable, and the mass ratio below
+    which the massless error is < 1e-4."""
     base = rig("plate")
     t_massless = yaw_period(massless(base))
     out = []
