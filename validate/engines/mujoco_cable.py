@@ -17,7 +17,8 @@ attachment's velocity. The straight wire is not the sagged one at rest: its tran
 ~ pi sqrt(t / rho) / L) start with the sag's amplitude, and the joints between segments carry a
 damping that takes them out within a few of their periods without touching a straight wire's swing
 (the anchor joint is undamped). ``tension`` is the norm of the connect constraint's force, the pull
-of the wire on the body at its end; ``length_error`` is the anchor-attachment distance minus the
+of the wire on the body at its end (at t = 0 the force rigid rows would carry,
+:func:`rigid_connect_forces`); ``length_error`` is the anchor-attachment distance minus the
 wire's length (the sag makes it slightly negative); ``energy`` is MuJoCo's, body and chains.
 
 Numerics: MuJoCo's implicitfast at :data:`TIMESTEP` (the chain's fastest mode, omega ~ 2 N sqrt(t /
@@ -172,13 +173,46 @@ def initial_qvel(rig: Rig, state: State, model: mujoco.MjModel) -> np.ndarray:
     return qvel
 
 
+def _connect_rows(data: mujoco.MjData) -> np.ndarray:
+    return np.flatnonzero(data.efc_type[:data.nefc] == mujoco.mjtConstraint.mjCNSTR_EQUALITY)
+
+
+def _connect_jacobian(model: mujoco.MjModel, data: mujoco.MjData) -> np.ndarray:
+    if not mujoco.mj_isSparse(model):
+        return np.asarray(data.efc_J, dtype=float)[:data.nefc * model.nv].reshape(-1, model.nv)[_connect_rows(data)]
+    dense = np.zeros((data.nefc, model.nv))  # MuJoCo keeps J sparse from 60 dofs on
+    mujoco.mju_sparse2dense(dense, data.efc_J, data.efc_J_rownnz[:data.nefc], data.efc_J_rowadr[:data.nefc],
+                            data.efc_J_colind)
+    return dense[_connect_rows(data)]
+
+
+def rigid_connect_forces(model: mujoco.MjModel, data: mujoco.MjData) -> np.ndarray:
+    """The connect rows' forces (N, 3 per wire) if they were rigid, at the current state (after
+    ``mj_forward``): J qacc + J' qvel = 0 with qacc = a0 - M^-1 J^T f, so (J M^-1 J^T) f = J a0 + J' qvel
+    (a0 MuJoCo's unconstrained acceleration, J' qvel by a central difference), as
+    :func:`validate.engines.mujoco_rig.settled_tensions` does for the rig's cables. The first sample
+    reads these: the soft rows start unstretched and carry only part of the load at t = 0."""
+    J = _connect_jacobian(model, data)
+    v = data.qvel.copy()
+    eps = 1e-6 / max(float(np.abs(v).max()), 1.0)  # s; central difference, error ~ (|v| eps)^2
+    probe = mujoco.MjData(model)
+    rates = []
+    for sign in (1.0, -1.0):
+        probe.qpos[:] = data.qpos
+        mujoco.mj_integratePos(model, probe.qpos, v, sign * eps)
+        mujoco.mj_fwdPosition(model, probe)
+        rates.append(_connect_jacobian(model, probe) @ v)
+    X = np.empty_like(J)
+    mujoco.mj_solveM(model, data, X, J)
+    return np.linalg.solve(J @ X.T, J @ data.qacc_smooth + (rates[0] - rates[1]) / (2.0 * eps))
+
+
 def _sample(model, data, rig: Rig, times: np.ndarray, nstep: int, dt_out: float,
             max_seconds: float | None) -> Trajectory:
     n = len(times)
     nw = len(rig.wires)
     qpos, qvel = np.empty((n, 7)), np.empty((n, 6))
     tension, distance, energy = np.empty((n, nw)), np.empty((n, nw)), np.empty(n)
-    eq_rows = mujoco.mjtConstraint.mjCNSTR_EQUALITY
     attach_site = np.array([w.attach for w in rig.wires])
     started = time.monotonic()
     with _quiet_warnings():
@@ -190,9 +224,8 @@ def _sample(model, data, rig: Rig, times: np.ndarray, nstep: int, dt_out: float,
             if not np.all(np.isfinite(data.qpos)):
                 raise IntegrationError(f"mujoco-cable: non-finite state by t = {k * dt_out:g} s")
             qpos[k], qvel[k] = data.qpos[:7], data.qvel[:6]
-            rows = np.flatnonzero(data.efc_type[:data.nefc] == eq_rows)
-            force = data.efc_force[rows].reshape(-1, 3)  # one connect (3 world rows) per wire, in order
-            tension[k] = np.linalg.norm(force, axis=1)
+            force = data.efc_force[_connect_rows(data)] if k else rigid_connect_forces(model, data)
+            tension[k] = np.linalg.norm(force.reshape(-1, 3), axis=1)  # one connect (3 world rows) a wire
             points = data.xpos[1] + (data.xmat[1].reshape(3, 3) @ attach_site.T).T
             distance[k] = np.linalg.norm(points - anchors(rig), axis=1)
             energy[k] = data.energy.sum()
