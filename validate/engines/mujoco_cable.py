@@ -19,13 +19,14 @@ damping that takes them out within a few of their periods without touching a str
 (the anchor joint is undamped). ``tension`` is the norm of the connect constraint's force, the pull
 of the wire on the body at its end (at t = 0 the force rigid rows would carry,
 :func:`rigid_connect_forces`); ``length_error`` is the anchor-attachment distance minus the
-wire's length (the sag makes it slightly negative); ``energy`` is MuJoCo's, body and chains.
+wire's length (the sag shortens it by O(ratio^2) L, the connect rows' stretch, ~5e-8 m,
+lengthens it); ``energy`` is MuJoCo's, body and chains.
 
 Numerics: MuJoCo's implicitfast at :data:`TIMESTEP` (the chain's fastest mode, omega ~ 2 N sqrt(t /
 rho) / L, is ~2e3 rad/s for the rigs of tests and cases: omega h ~ 0.2), connect rows with the rig
 engine's solref (2 h, 0.5) and solimp d = 0.9999 (:data:`IMPEDANCE`: at the rig engine's 0.99 the
-rows, tied to a light segment, stretched 4.5e-7 m on the parallel rig and cost 1.5e-6 in the period;
-RK4 at 1e-4 s went unstable). Velocities are those of the step, not staggered as in
+rows, tied to a light segment, stretched 4.5e-7 m on the parallel rig and cost 1.5e-6 in the period).
+Velocities are those of the step, not staggered as in
 :mod:`validate.engines.mujoco_rig`: a period is insensitive to that half step.
 """
 
@@ -65,6 +66,9 @@ def run(rig: Rig, duration: float, dt_out: float = 0.01, rtol: float = 1e-10, st
     if missing:
         raise RigError(rig.source, f"wire[{missing[0]}].linear_density", "missing: the mujoco-cable engine models "
                        "heavy wires; give every wire a linear_density (kg/m), or use --engine mujoco")
+    if rig.air is not None:
+        raise RigError(rig.source, "air", "the mujoco-cable engine has no fluid model: simulate heavy wires in a "
+                       "vacuum (drop [air]), or the air on massless wires with --engine kane or mujoco")
     nstep = round(dt_out / timestep)
     if nstep < 1 or abs(nstep * timestep - dt_out) > 1e-9 * dt_out:
         raise EngineInputError("--dt-out", f"{dt_out:g} s is not a whole number of MuJoCo time steps ({timestep:g} s)")
@@ -94,8 +98,14 @@ def chain_points(rig: Rig, state: State, segments: int) -> np.ndarray:
     return anchors(rig)[:, None, :] * (1.0 - f) + ends[:, None, :] * f
 
 
+def fmt(values) -> str:
+    """Numbers as an MJCF attribute, to the last bit."""
+    return " ".join(f"{x:.17g}" for x in np.ravel(values))
+
+
 def _mjcf(rig: Rig, state: State, segments: int, timestep: float) -> str:
-    fmt = lambda v: " ".join(f"{x:.17g}" for x in np.ravel(v))  # noqa: E731 (one-line formatter)
+    """The model as MJCF text: the body (free joint, first, so qpos[:7] and qvel[:6] are its own) and one
+    chain per wire, every body frame world-aligned at ``state``."""
     origin = state.com - state.rotation @ rig.com
     quat = Rotation.from_matrix(state.rotation).as_quat(scalar_first=True)
     inertia = rig.inertia
@@ -108,7 +118,6 @@ def _mjcf(rig: Rig, state: State, segments: int, timestep: float) -> str:
         pts = points[i]
         seg = pts[1] - pts[0]
         l = float(np.linalg.norm(seg))
-        e = seg / l
         m = w.linear_density * w.length / segments
         across = m * l * l / 12.0
         inertial = f'<inertial pos="{fmt(seg / 2)}" mass="{m:.17g}" diaginertia="{fmt([across] * 3)}"/>'
