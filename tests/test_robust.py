@@ -298,7 +298,7 @@ def test_help_lists_exit_codes_an_example_and_option_units():
                  "python -m validate modes models/rigs/plate.toml"):
         assert text in proc.stdout, text
     sim = _cli("simulate", "--help").stdout
-    for text in ("{kane,nwire,mujoco,mujoco-eq}", "simulated time, s", "(default: 0.01)", "(default: 1e-10",
+    for text in ("{kane,nwire,mujoco,mujoco-eq,mujoco-cable}", "simulated time, s", "(default: 0.01)", "(default: 1e-10",
                  "wall-time budget of the run, s"):
         assert text in " ".join(sim.split()), text
 
@@ -359,15 +359,18 @@ def test_the_module_writer_does_not_overwrite_another_models_scene(tmp_path, cap
     assert not (tmp_path / "asymmetric.xml").exists()
 
 
-def test_numba_cache_is_outside_the_source_tree_and_a_first_compile_is_announced(tmp_path):
+def test_numba_cache_is_outside_the_source_tree_and_a_first_compile_is_announced(tmp_path, monkeypatch):
     """A fresh cache folder: the first Kane run says, in one line, that it compiles; the second is quiet."""
     env = {**os.environ, "XDG_CACHE_HOME": str(tmp_path)}
     env.pop("NUMBA_CACHE_DIR", None)
     code = "import bifilar.motion.kane_kernel, numba; print(numba.config.CACHE_DIR)"
     proc = subprocess.run([sys.executable, "-c", code], cwd=ROOT, env=env, capture_output=True, text=True, timeout=60)
     assert proc.stdout.strip() == str(tmp_path / "bifilar-validate" / "numba")
+    from bifilar import jit
     from bifilar.jit import announce_compile
     from bifilar.motion import kane_kernel as K
+
+    monkeypatch.setattr(jit, "_announced", set())  # as in a new process (an earlier test may have announced all)
 
     class Fresh:  # a kernel without a cache entry, as numba sees a first run
         class _cache:

@@ -89,7 +89,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--engine", default="kane", choices=ENGINE_NAMES,
                    help="kane: the hand-derived model (Kane-Tseng for two wires, the N-wire model otherwise; "
                         "stops where a wire goes slack); nwire: the N-wire model on any rig; mujoco: tendon "
-                        "cables that may go slack; mujoco-eq: equality cables (default: kane)")
+                        "cables that may go slack; mujoco-eq: equality cables; mujoco-cable: heavy wires (linear_density) "
+                        "as chains of rigid segments with their mass (default: kane)")
     p.add_argument("--duration", type=bounded_float("--duration", 0.0, MAX_DURATION, "s", low_open=True),
                    required=True, help=f"simulated time, s, > 0 and at most {MAX_DURATION:g}")
     p.add_argument("--dt-out", type=bounded_float("--dt-out", 0.0, 100.0, "s", low_open=True), default=0.01,
@@ -290,6 +291,7 @@ def _cmd_modes(args) -> int:
     rig, rest = _load(args.rig)
     lin = linearize(rig, rest)
     rest = lin.rest
+    light = _massless_modes(rig)
     report = {
         "rig": rig.name,
         "model": "pose-coordinate linearisation (bifilar.motion.modes)",
@@ -301,10 +303,13 @@ def _cmd_modes(args) -> int:
         "modes": [
             {"motion": m.motion, "period": m.period, "frequency": m.frequency, "omega2": m.omega2,
              **({"kind": _mode_kind(m), "stretch_share": m.stretch_share} if rig.elastic else {}),
-             "com_shape": m.com.tolist(), "rotation_shape": m.rotation.tolist()}
-            for m in lin.modes
+             "com_shape": m.com.tolist(), "rotation_shape": m.rotation.tolist(),
+             **({} if light is None else {"massless_period": light.modes[k].period})}
+            for k, m in enumerate(lin.modes)
         ],
     }
+    if light is not None:
+        report["model"] += ", heavy wires to first order in their mass (docs/heavy-wires.md); tensions at the body end"
     if args.json:
         print(json.dumps(report, allow_nan=False))
         return 0
@@ -312,7 +317,9 @@ def _cmd_modes(args) -> int:
     for i, m in enumerate(lin.modes, start=1):
         period = "neutral" if m.period is None else f"{m.period:.9g} s ({m.frequency:.6g} Hz)"
         kind = f", {_mode_kind(m)}: {m.stretch_share:.3g} of its energy in wire stretch" if rig.elastic else ""
-        print(f"  mode {i} ({m.motion}{kind}): period {period}; COM shape {_fmt(m.com)} m, "
+        heavy = "" if light is None or light.modes[i - 1].period is None else \
+            f" [massless wires: {light.modes[i - 1].period:.9g} s]"
+        print(f"  mode {i} ({m.motion}{kind}): period {period}{heavy}; COM shape {_fmt(m.com)} m, "
               f"rotation shape {_fmt(m.rotation)} rad")
     return 0
 
@@ -320,6 +327,15 @@ def _cmd_modes(args) -> int:
 def _mode_kind(mode) -> str:
     """``fast`` for a mode held by the wires' stretch (bounce, roll, pitch), ``slow`` for a pendulum mode."""
     return "fast" if mode.stretch_share > 0.5 else "slow"
+
+
+def _massless_modes(rig):
+    """The modes of ``rig`` on massless wires if its wires are heavy (shown beside the corrected
+    ones), else None."""
+    from bifilar.motion.modes import linearize
+    from bifilar.rig.heavy import has_wire_mass, massless
+
+    return linearize(massless(rig)) if has_wire_mass(rig) else None
 
 
 def _cmd_simulate(args) -> int:
@@ -336,6 +352,10 @@ def _cmd_simulate(args) -> int:
         raise UsageError(f"--duration: {args.duration:g} s every --dt-out {args.dt_out:g} s is {n_samples} samples, "
                          f"more than {MAX_SAMPLES}: shorten --duration or lengthen --dt-out")
     rig, _ = _load(args.rig)
+    heavy = [i for i, w in enumerate(rig.wires, start=1) if w.linear_density > 0.0]
+    if heavy and args.engine != "mujoco-cable":
+        raise RigError(args.rig, f"wire[{heavy[0]}].linear_density", f"the {args.engine} engine models massless "
+                       "wires: simulate heavy wires with --engine mujoco-cable")
     try:
         traj = engines()[args.engine](rig, args.duration, args.dt_out, args.rtol, max_seconds=args.max_seconds)
         failure = traj.meta.get("taut_failure")

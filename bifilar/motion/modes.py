@@ -36,7 +36,8 @@ from scipy.linalg import eigh
 
 from bifilar.bodies.air import added_mass
 from bifilar.rig import Rig
-from bifilar.rig import elastic
+from bifilar.rig import elastic, heavy
+from bifilar.rig.heavy import has_wire_mass
 from bifilar.rig.statics import NULL_RTOL, PK, Rest, State, anchors, arms, rest_pose, rig_scale
 
 NEUTRAL_RTOL = 1e-9  # an eigenvalue below this fraction of the largest is neutral (or unstable)
@@ -175,16 +176,23 @@ def _resolve_degenerate(w2: np.ndarray, vecs: np.ndarray, z: np.ndarray, m6: np.
 
 
 def linearize(rig: Rig, rest: Rest | None = None) -> Modes:
-    """Mass and stiffness matrices about the rest pose and the normal modes."""
-    rest = rest_pose(rig) if rest is None else rest
-    z, mr, kr = reduced(rig, rest)
+    """Mass and stiffness matrices about the rest pose and the normal modes. Heavy wires
+    (``linear_density``) enter to first order in their mass (:func:`bifilar.rig.heavy.system`; ``rest``
+    is then recomputed, the rest tensions are the pull at the body end)."""
+    if has_wire_mass(rig):
+        rest, z, m6, kr = heavy.system(rig)
+        m6 = m6 + air_mass_world(rig, rest)
+        mr = 0.5 * (z.T @ m6 @ z + (z.T @ m6 @ z).T)
+    else:
+        rest = rest_pose(rig) if rest is None else rest
+        z, mr, kr = reduced(rig, rest)
+        m6 = np.zeros((6, 6))
+        m6[:3, :3] = rig.mass * np.eye(3)
+        m6[3:, 3:] = rest.rotation @ rig.inertia @ rest.rotation.T
+        m6 += air_mass_world(rig, rest)
     if z.shape[1] == 0:
         return Modes(rest, (), mr, kr, z)
     w2, vecs = eigh(kr, mr)
-    m6 = np.zeros((6, 6))
-    m6[:3, :3] = rig.mass * np.eye(3)
-    m6[3:, 3:] = rest.rotation @ rig.inertia @ rest.rotation.T
-    m6 += air_mass_world(rig, rest)
     vecs = _resolve_degenerate(w2, vecs, z, m6)
     scale = max(np.linalg.norm(arms(rig), axis=1).max(), 1e-3)
     modes = []

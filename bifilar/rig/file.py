@@ -40,9 +40,10 @@ __all__ = ["Rig", "RigError", "Uncertainty", "Wire", "load_rig", "rig_from_dict"
 
 @dataclass(frozen=True)
 class Wire:
-    """A massless wire from a ceiling ``anchor`` (world, m) to ``attach`` (body, m): inextensible of
-    ``length`` (m) when ``axial_stiffness`` is None, else elastic: ``length`` is its unstretched length
-    and it pulls with EA (d - L) / L at a distance d > L (``axial_stiffness`` = EA, N), never pushes."""
+    """A wire from a ceiling ``anchor`` (world, m) to ``attach`` (body, m): inextensible of ``length`` (m)
+    when ``axial_stiffness`` is None, else elastic: ``length`` is its unstretched length and it pulls
+    with EA (d - L) / L at a distance d > L (``axial_stiffness`` = EA, N), never pushes. Massless unless
+    ``linear_density`` (kg/m) is given (heavy wires, inextensible only: :mod:`bifilar.rig.heavy`)."""
 
     anchor: np.ndarray
     attach: np.ndarray
@@ -53,6 +54,7 @@ class Wire:
     def spring(self) -> float:
         """EA / L (N/m), the elastic wire's spring constant; inf for an inextensible wire."""
         return np.inf if self.axial_stiffness is None else self.axial_stiffness / self.length
+    linear_density: float = 0.0  # kg/m; 0: massless
 
 
 @dataclass(frozen=True)
@@ -99,7 +101,7 @@ class Rig:
 
 _TOP_KEYS = {"name", "gravity", "body", "wire", "initial", "uncertainty", "air"}
 _BODY_KEYS = {"mass", "com", "inertia"}
-_WIRE_KEYS = {"anchor", "attach", "length", "axial_stiffness"}
+_WIRE_KEYS = {"anchor", "attach", "length", "axial_stiffness", "linear_density"}
 _INITIAL_KEYS = {"rotation", "omega"}
 _UNCERTAINTY_KEYS = set(Uncertainty.__dataclass_fields__)
 
@@ -136,6 +138,7 @@ def rig_from_dict(data: dict, source: str = "<memory>", default_name: str = "rig
         raise RigError(source, "wire", "missing: give the wires as [[wire]] tables")
     if not 2 <= len(wires_raw) <= MAX_WIRES:
         raise RigError(source, "wire", f"2 to {MAX_WIRES} [[wire]] tables needed, found {len(wires_raw)}")
+    _check_heavy_inextensible(wires_raw, source)
     wires = []
     for i, w in enumerate(wires_raw, start=1):
         prefix = f"wire[{i}]."
@@ -147,6 +150,8 @@ def rig_from_dict(data: dict, source: str = "<memory>", default_name: str = "rig
                 length=positive(required(w, "length", source, prefix), source, prefix + "length"),
                 axial_stiffness=(positive(w["axial_stiffness"], source, prefix + "axial_stiffness")
                                  if "axial_stiffness" in w else None),
+                linear_density=positive(w["linear_density"], source, prefix + "linear_density")
+                if "linear_density" in w else 0.0,
             )
         )
     given = [w.axial_stiffness is not None for w in wires]
@@ -187,6 +192,16 @@ def rig_from_dict(data: dict, source: str = "<memory>", default_name: str = "rig
     check_ranges(rig, free_moment)
     check_reachable(rig)
     return rig
+
+
+def _check_heavy_inextensible(wires_raw: list[dict], source: str) -> None:
+    """Refuse heavy wires (``linear_density``) on a rig with elastic ones (``axial_stiffness``): the
+    heavy-wire correction (docs/heavy-wires.md) is derived for inextensible wires only."""
+    heavy = [i for i, w in enumerate(wires_raw, start=1) if "linear_density" in w]
+    elastic = [i for i, w in enumerate(wires_raw, start=1) if "axial_stiffness" in w]
+    if heavy and elastic:
+        raise RigError(source, f"wire[{heavy[0]}].linear_density", f"heavy wires are modelled inextensible: not "
+                       f"with axial_stiffness (wire[{elastic[0]}]); give one or the other")
 
 
 def check_reachable(rig: Rig) -> None:

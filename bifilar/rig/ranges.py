@@ -24,6 +24,7 @@ RANGES = {
     "body.mass": (1e-3, 1e6, "kg", "from a gram to a thousand tonnes"),
     "wire[i].length": (1e-3, 1e3, "m", "from a millimetre to a kilometre"),
     "wire[i].axial_stiffness": (1.0, 1e10, "N", "E A: from a thin rubber cord to a 10 cm steel bar"),
+    "wire[i].linear_density": (0.0, 10.0, "kg/m", "positive, up to a 4 cm steel rope's; heavy wires: docs/heavy-wires.md"),
     "coordinates": (-1e4, 1e4, "m", "every component of anchor, attach and com"),
     "air.density": (1e-3, 2e3, "kg/m^3", "from thin air to twice water's"),
     "air.viscosity": (0.0, 10.0, "Pa s", "0 (inviscid) to ten thousand times water's"),
@@ -33,6 +34,7 @@ RANGES = {
 # The air's ellipsoid: each semi-axis between these fractions of the rig's size, its centre at most
 # MAX_COM_OFFSET x the size from the COM (it is the body's own outline).
 AIR_SIZE = (1e-4, 10.0)
+MAX_WIRE_MASS = 0.5  # x body.mass: one wire's mass; heavier, the first-order heavy-wire model is not a model
 MAX_WIRES = 64  # a rig is a body on a few wires; a 100,000-wire file is a mistake (it crashed MuJoCo)
 MIN_ATTACH_SPAN = 1e-3  # x S: closer attachments hang the body from one point (a 1e-8 m pair is singular)
 MAX_COM_OFFSET = 10.0  # x S: the COM's distance from the nearest attachment
@@ -75,6 +77,12 @@ def check_ranges(rig, free_moment: int | None = None) -> None:
         if w.axial_stiffness is not None:
             lo, hi, u, reason = RANGES["wire[i].axial_stiffness"]
             within(w.axial_stiffness, lo, hi, src, f"wire[{i}].axial_stiffness", u, reason)
+        if w.linear_density:
+            lo, hi, u, reason = RANGES["wire[i].linear_density"]
+            within(w.linear_density, lo, hi, src, f"wire[{i}].linear_density", u, reason)
+            within(w.linear_density * w.length, 0.0, MAX_WIRE_MASS * rig.mass, src, f"wire[{i}].linear_density", "kg",
+                   f"the wire's mass, at most {MAX_WIRE_MASS:g} x the body's {rig.mass:.6g} kg: the heavy-wire model "
+                   "is first order in that ratio")
 
     size = rig_size(rig.wires)
     span = float(np.linalg.norm(rig.wires[0].attach - rig.wires[1].attach))

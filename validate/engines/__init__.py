@@ -33,12 +33,12 @@ class EngineInputError(ValueError):
         super().__init__(message)
 
 
-NAMES = ("kane", "nwire", "mujoco", "mujoco-eq")  # the keys of engines(), known without importing them
+NAMES = ("kane", "nwire", "mujoco", "mujoco-eq", "mujoco-cable")  # the keys of engines(), known without importing them
 
 
 def engines() -> dict[str, EngineRun]:
     """Engine name -> run function (imported lazily so that one engine's import cost is paid only
     when it is used)."""
-    from . import kane, mujoco_rig, nwire
+    from . import kane, mujoco_cable, mujoco_rig, nwire
 
-    return {"kane": kane.run, "nwire": nwire.run, **mujoco_rig.ENGINES}
+    return {"kane": kane.run, "nwire": nwire.run, **mujoco_rig.ENGINES, "mujoco-cable": mujoco_cable.run}
