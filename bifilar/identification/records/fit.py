@@ -70,7 +70,8 @@ _BAD_RMS = 3.0  # a cycle's residual RMS above this times the record's median: n
 # per cent off the swing, where what a window's model leaves of a clean large swing is below 1 %
 _LOCK_FLOOR = 0.02
 _SECOND_DECAY_SPANS = 4.0  # the most a second mode may decay over the record, in e-folds
-_FREQUENCY_STEPS = 3  # Gauss-Newton steps on a window's frequency and decay
+_SECOND_SHARE = 0.5  # the largest second mode, relative to the first mode's largest swing
+_FREQUENCY_STEPS = 3  # Gauss-Newton steps on a window's frequency
 _FREQUENCY_RANGE = 0.05  # the largest relative step (a window's swing is within 5 % of the model's)
 _GLITCH_NEIGHBOURHOOD = 31  # samples (about half a cycle of a 60 fps video at 1 s): a glitch's scale
 _JUMP = math.log(1.5)  # a cycle's amplitude this far (in ln) from its neighbours' median: a jump
@@ -408,37 +409,34 @@ def _cycles(tau, y, usable, centres, omegas, decays, chirps, rate: bool) -> _Cyc
 
 
 def _window_fit(u: np.ndarray, y: np.ndarray, w: float, lam: float, harmonics: int, chirp: float):
-    """(frequency, design, terms) of one window's least squares with its frequency and decay refined
-    from ``w`` and ``lam`` by Gauss-Newton (:data:`_FREQUENCY_STEPS` steps on the terms' joint
-    linearisation, each kept only where it lowers the residual, the frequency within
-    :data:`_FREQUENCY_RANGE` of ``w``): a window whose swing is far from the model's (the first pass's
-    single frequency, a cycle the model held from its neighbours, a swing decaying faster than the
-    record's smoothed decay says) would otherwise leave a residual that grows as its phase runs off the
-    window's, and be taken for a tracker that has not locked on. The phase at the centre, u = 0, does
-    not depend on either to first order (a symmetric window), so refining them moves the residual, not
-    the phase."""
-    def solve(wf, lf):
-        x = _basis(u, wf, lf, harmonics, chirp)
+    """(frequency, design, terms) of one window's least squares with its frequency refined from ``w``
+    by Gauss-Newton (:data:`_FREQUENCY_STEPS` steps on the terms' joint linearisation, each kept only
+    where it lowers the residual, within :data:`_FREQUENCY_RANGE` of ``w``): a window whose swing is
+    far from the model's (the first pass's single frequency, a cycle the model held from its
+    neighbours) would otherwise leave a residual that grows as its phase runs off the window's, and be
+    taken for a tracker that has not locked on. The phase at the centre, u = 0, does not depend on the
+    frequency to first order (a symmetric window), so refining it moves the residual, not the phase."""
+    def solve(wf):
+        x = _basis(u, wf, lam, harmonics, chirp)
         coef, *_ = np.linalg.lstsq(x, y, rcond=None)
         r = y - x @ coef
         return x, coef, float(r @ r)
 
-    x, coef, best = solve(w, lam)
-    wf, lf = w, lam
+    x, coef, best = solve(w)
+    wf = w
     for _ in range(_FREQUENCY_STEPS):
         phase = wf * u + 0.5 * chirp * u * u
         slope = np.zeros(len(u))
         for j, n in enumerate(range(1, harmonics + 1, 2)):  # d (x @ coef) / d w
             a, b = coef[1 + 2 * j], coef[2 + 2 * j]
             slope += n * (b * np.cos(n * phase) - a * np.sin(n * phase))
-        slope *= u * np.exp(lf * u)
-        grow = u * (x @ coef - coef[0])  # d (x @ coef) / d lam
-        step = np.linalg.lstsq(np.column_stack([x, slope, grow]), y - x @ coef, rcond=None)[0][-2:]
-        w_new = float(np.clip(wf + step[0], w * (1.0 - _FREQUENCY_RANGE), w * (1.0 + _FREQUENCY_RANGE)))
-        trial = solve(w_new, lf + float(step[1]))
+        slope *= u * np.exp(lam * u)
+        step = np.linalg.lstsq(np.column_stack([x, slope]), y - x @ coef, rcond=None)[0][-1]
+        w_new = float(np.clip(wf + step, w * (1.0 - _FREQUENCY_RANGE), w * (1.0 + _FREQUENCY_RANGE)))
+        trial = solve(w_new)
         if trial[2] >= best:
             break
-        wf, lf = w_new, lf + float(step[1])
+        wf = w_new
         x, coef, best = trial
     return wf, x, coef
 
@@ -916,14 +914,12 @@ def _second_mode(rec: _Record, cyc: _Cycles, baseline: np.ndarray, model: _Model
         beta = np.linalg.lstsq(z, rest, rcond=None)[0]
         return rest - z @ beta, beta
 
-    # a mode beating in lasts the record (it decays by at most e^-SECOND_DECAY_SPANS over it) and is
-    # smaller than the first: a fast transient at the start fitted as one would take the first
-    # cycles' swing with it
+    # a mode beating in lasts the record (it decays by at most e^-SECOND_DECAY_SPANS over it: a fast
+    # transient at the start fitted as one would take the first cycles' swing with it); that it is
+    # smaller than the one released is asked of the whole fit (:func:`_whole`), once the law has settled
     sol = least_squares(lambda p: fitted(p)[0], [peak, 0.0], bounds=([0.0, 0.0], [np.inf, _SECOND_DECAY_SPANS / span]),
                         x_scale=[resolution, 1.0 / span], xtol=1e-10)
     c2, s2 = fitted(sol.x)[1]
-    if math.hypot(c2, s2) * math.exp(-sol.x[1] * tau[0]) > float(np.max(cyc.fundamental[good])):
-        return None
     return _Second(float(sol.x[0]), float(sol.x[1]), float(c2), float(s2))
 
 
@@ -978,15 +974,24 @@ def _whole(rec: _Record, cyc: _Cycles, model: _Model, baseline: np.ndarray, seco
     harmonics = _harmonics(float(np.median([len(cyc.index[k]) for k in good])))
     _, _, phi0, omega0, _, _ = model._phase
     first = [phi0, omega0, math.log(float(np.median(cyc.fundamental[good])) / level), 0.0]
+    largest = _SECOND_SHARE * float(np.max(envelope))
+
+    def plausible(f) -> bool:
+        """Its second mode at most _SECOND_SHARE of the first: a law misfit near the first mode's
+        frequency would pass for one of comparable size."""
+        return math.hypot(*f[3][-2:]) * math.exp(-f[0][5] * tau[0]) <= largest
+
     fit = _whole_fit(tau, y, u, integral, envelope, level, harmonics, first, second)
+    if second is not None and not plausible(fit):
+        second = None
+        fit = _whole_fit(tau, y, u, integral, envelope, level, harmonics, first, None)
     if second is None:
         chirp = float(np.ptp(model.local_omega(cyc.centre[good])))
         peak = _peak_apart(tau, fit[2], fit[0][1], chirp)
         if peak is not None:
             with_second = _whole_fit(tau, y, u, integral, envelope, level, harmonics, list(fit[0][:4]),
                                      _Second(peak, 0.0, 0.0, 0.0))
-            c2, s2 = with_second[3][-2:]
-            if math.hypot(c2, s2) * math.exp(-with_second[0][5] * tau[0]) <= float(np.max(envelope)):
+            if plausible(with_second):
                 fit, second = with_second, _Second(peak, 0.0, 0.0, 0.0)
     q, jac, r, beta, model_y = fit
     n, k = jac.shape
