@@ -21,7 +21,7 @@ from numba import njit
 
 from bifilar.motion.kane_kernel import P_AIR as AIR_FLAG
 from bifilar.motion.kane_kernel import air_terms
-from bifilar.motion.nwire_kernel import STATE_SIZE, _cross, quat_matrix
+from bifilar.motion.nwire_kernel import STATE_SIZE, _cross, quat_matrix, state_rate
 
 
 @njit(cache=True)
@@ -62,16 +62,7 @@ def dynamics(y, arms, anchors, lengths, springs, inertia_body, mass, gravity, ai
 @njit(cache=True)
 def rhs(y, arms, anchors, lengths, springs, inertia_body, mass, gravity, air):
     """y'; q' = (1/2) (0, omega) * q (world omega)."""
-    acc = dynamics(y, arms, anchors, lengths, springs, inertia_body, mass, gravity, air)[0]
-    q, om = y[3:7], y[10:13]
-    dy = np.empty(STATE_SIZE)
-    dy[0:3] = y[7:10]
-    dy[3] = -0.5 * (om[0] * q[1] + om[1] * q[2] + om[2] * q[3])
-    dy[4] = 0.5 * (om[0] * q[0] + om[1] * q[3] - om[2] * q[2])
-    dy[5] = 0.5 * (-om[0] * q[3] + om[1] * q[0] + om[2] * q[1])
-    dy[6] = 0.5 * (om[0] * q[2] - om[1] * q[1] + om[2] * q[0])
-    dy[7:13] = acc
-    return dy
+    return state_rate(y, dynamics(y, arms, anchors, lengths, springs, inertia_body, mass, gravity, air)[0])
 
 
 @njit(cache=True)

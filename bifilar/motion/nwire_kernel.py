@@ -138,7 +138,13 @@ def dynamics_jacobian(y, arms, anchors):
 @njit(cache=True)
 def rhs(y, arms, anchors, inertia_body, mass, gravity, air):
     """y' for the state layout of the module docstring; q' = (1/2) (0, omega) * q (world omega)."""
-    acc = dynamics(y, arms, anchors, inertia_body, mass, gravity, air)[0]
+    return state_rate(y, dynamics(y, arms, anchors, inertia_body, mass, gravity, air)[0])
+
+
+@njit(cache=True)
+def state_rate(y, acc):
+    """y' of a free rigid body (the module docstring's layout) whose COM and angular accelerations
+    (world) are ``acc``: velocities, q' = (1/2) (0, omega) * q (world omega), accelerations."""
     q, om = y[3:7], y[10:13]
     dy = np.empty(STATE_SIZE)
     dy[0:3] = y[7:10]

@@ -45,7 +45,7 @@ from bifilar.rig.statics import State, anchors, initial_state
 
 from ..trajectory import Trajectory
 from . import EngineInputError
-from .mujoco_rig import _check_warnings, _quiet_warnings, rig_channels
+from .mujoco_rig import _check_warnings, _quiet_warnings, jacobian_rate, rig_channels
 
 SEGMENTS = 16  # per wire; the bending it leaves out is second order in the mass ratio
 TIMESTEP = 1e-4  # s
@@ -202,18 +202,9 @@ def rigid_connect_forces(model: mujoco.MjModel, data: mujoco.MjData) -> np.ndarr
     :func:`validate.engines.mujoco_rig.settled_tensions` does for the rig's cables. The first sample
     reads these: the soft rows start unstretched and carry only part of the load at t = 0."""
     J = _connect_jacobian(model, data)
-    v = data.qvel.copy()
-    eps = 1e-6 / max(float(np.abs(v).max()), 1.0)  # s; central difference, error ~ (|v| eps)^2
-    probe = mujoco.MjData(model)
-    rates = []
-    for sign in (1.0, -1.0):
-        probe.qpos[:] = data.qpos
-        mujoco.mj_integratePos(model, probe.qpos, v, sign * eps)
-        mujoco.mj_fwdPosition(model, probe)
-        rates.append(_connect_jacobian(model, probe) @ v)
     X = np.empty_like(J)
     mujoco.mj_solveM(model, data, X, J)
-    return np.linalg.solve(J @ X.T, J @ data.qacc_smooth + (rates[0] - rates[1]) / (2.0 * eps))
+    return np.linalg.solve(J @ X.T, J @ data.qacc_smooth + jacobian_rate(model, data, _connect_jacobian))
 
 
 def _sample(model, data, rig: Rig, times: np.ndarray, nstep: int, dt_out: float,

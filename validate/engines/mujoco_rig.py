@@ -178,6 +178,21 @@ def row_coupling(model: mujoco.MjModel, rig: Rig, state: State) -> float:
     return float(np.diag(A).max() / max(np.linalg.eigvalsh(A)[0], np.finfo(float).tiny))
 
 
+def jacobian_rate(model: mujoco.MjModel, data: mujoco.MjData, jacobian) -> np.ndarray:
+    """J' qvel at the current state, J = ``jacobian(model, data)`` (constraint rows by dof): a central
+    difference of J qvel along qvel, the curvature term of a constraint held at zero acceleration."""
+    v = data.qvel.copy()
+    eps = 1e-6 / max(float(np.abs(v).max()), 1.0)  # s; central difference, error ~ (|v| eps)^2
+    probe = mujoco.MjData(model)
+    rates = []
+    for sign in (1.0, -1.0):
+        probe.qpos[:] = data.qpos
+        mujoco.mj_integratePos(model, probe.qpos, v, sign * eps)
+        mujoco.mj_fwdPosition(model, probe)
+        rates.append(jacobian(model, probe) @ v)
+    return (rates[0] - rates[1]) / (2.0 * eps)
+
+
 def _tendon_jacobian(model: mujoco.MjModel, data: mujoco.MjData) -> np.ndarray:
     return np.asarray(data.ten_J, dtype=float).reshape(model.ntendon, model.nv)
 
@@ -197,17 +212,7 @@ def settled_tensions(model: mujoco.MjModel, data: mujoco.MjData, cables: str) ->
     difference of J qvel along qvel). A tendon cable that would have to push is slack (0) and the
     others are solved without it; an equality cable keeps its sign."""
     J = _tendon_jacobian(model, data)
-    v = data.qvel.copy()
-    eps = 1e-6 / max(float(np.abs(v).max()), 1.0)  # s; central difference, error ~ (|v| eps)^2
-    probe = mujoco.MjData(model)
-    rates = []
-    for sign in (1.0, -1.0):
-        probe.qpos[:] = data.qpos
-        mujoco.mj_integratePos(model, probe.qpos, v, sign * eps)
-        mujoco.mj_fwdPosition(model, probe)
-        rates.append(_tendon_jacobian(model, probe) @ v)
-    curvature = (rates[0] - rates[1]) / (2.0 * eps)
-    rhs = J @ data.qacc_smooth + curvature
+    rhs = J @ data.qacc_smooth + jacobian_rate(model, data, _tendon_jacobian)
     A = _cable_inverse_inertia(model, data)
     taut = np.ones(len(rhs), dtype=bool)
     tension = np.zeros(len(rhs))
