@@ -66,10 +66,10 @@ def test_tensor_from_closed_form_periods():
         carrier, q = mounted(e, np.eye(3) * 0.1)
         period = 2 * np.pi * np.sqrt(1.5 * (e @ TRUE_INERTIA @ e) / (2.0 * 9.81 * 0.09))
         hangings.append(Hanging(carrier, period, 0.0, q))
-    result = identify_tensor(hangings)
+    result = identify_tensor(hangings, np.eye(3) * 0.1)
     np.testing.assert_allclose(result.inertia, TRUE_INERTIA, rtol=0, atol=1e-10 * 0.12)
     with pytest.raises(RigError, match="cannot determine"):
-        identify_tensor(hangings[:5])
+        identify_tensor(hangings[:5], np.eye(3) * 0.1)
 
 
 def test_slack_stops_the_run_with_status_3(tmp_path, capsys):

@@ -23,7 +23,9 @@ from .engines import NAMES as ENGINE_NAMES
 from .argtypes import OneLineParser, UsageError, bounded_float, positive_float, whole_number
 from .commands import boat as boat_cli
 from .commands import identify as identify_cli
+from .commands import plan as plan_cli
 from .commands import sweep as sweep_cli
+from .commands import tensor as tensor_cli
 from .statuses import BAD_INPUT, BROKEN_PIPE, INTERRUPTED, OK, RUN_FAILED, WENT_SLACK, epilog
 
 EPILOG = epilog(examples=(
@@ -112,6 +114,8 @@ def build_parser() -> argparse.ArgumentParser:
 
     identify_cli.add_parser(sub)
     boat_cli.add_parser(sub)
+    tensor_cli.add_parser(sub)
+    plan_cli.add_parser(sub)
     sweep_cli.add_parser(sub)
     sweep = sub.choices["sweep"]
     sweep.epilog = sweep.epilog or epilog("sweep", ("python -m validate sweep bench_plate --out sweep/ --png",))
@@ -514,5 +518,7 @@ _COMMANDS = {
     "mjcf": _cmd_mjcf,
     "identify": identify_cli.run,
     "boat": boat_cli.run,
+    "tensor": tensor_cli.run,
+    "plan": plan_cli.run,
     "sweep": sweep_cli.run,
 }

@@ -33,6 +33,8 @@ COMMANDS: dict[str, dict[int, str]] = {
     "mjcf": dict.fromkeys(_EVERY, ""),
     "identify": dict.fromkeys(_EVERY, ""),
     "boat": dict.fromkeys(_EVERY, ""),
+    "tensor": dict.fromkeys(_EVERY, ""),
+    "plan": dict.fromkeys(_EVERY, ""),
     "sweep": {**dict.fromkeys(_EVERY, ""), CHECK_FAILED: "--check-mujoco: a configuration's MuJoCo periods "
                                                          "differ from the sweep's by more than 1e-6"},
 }
