@@ -14,6 +14,7 @@ import json
 import math
 import os
 import pickle
+import sys
 import tempfile
 from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
@@ -87,6 +88,23 @@ def _save(folder: Path, name: str, rows: list[dict]) -> None:
     os.replace(tmp, folder / name)
 
 
+def _load(f: Path, size: int) -> list[dict] | None:
+    """The rows saved in chunk file ``f`` (``size`` of them), or None if there is none. A file that is
+    not such a list (truncated or garbled by a killed run or a full disk) is named on stderr and
+    deleted, so that its chunk is recomputed rather than every rerun failing on it."""
+    if not f.exists():
+        return None
+    try:
+        rows = json.loads(f.read_text())
+        if isinstance(rows, list) and len(rows) == size and all(isinstance(r, dict) for r in rows):
+            return rows
+    except (OSError, ValueError):  # JSONDecodeError and UnicodeDecodeError are ValueErrors
+        pass
+    print(f"sweep: {f} is unreadable (truncated?): recomputing it", file=sys.stderr, flush=True)
+    f.unlink(missing_ok=True)
+    return None
+
+
 def run(path: str, space: Space, out: Path, jobs: int = 1, scheduler: str | None = None, progress=None,
         chunk: int | None = None) -> list[dict]:
     """Every row of the sweep, in grid order, in chunks of ``chunk`` (default :func:`chunk_size`).
@@ -96,10 +114,10 @@ def run(path: str, space: Space, out: Path, jobs: int = 1, scheduler: str | None
     folder = out / ".chunks" / digest(path, chunk)
     folder.mkdir(parents=True, exist_ok=True)
     done: dict[int, list[dict]] = {}
-    for k in range(len(chunks)):
-        f = folder / f"{k:06d}.json"
-        if f.exists():
-            done[k] = json.loads(f.read_text())
+    for k, (start, stop) in enumerate(chunks):
+        rows = _load(folder / f"{k:06d}.json", stop - start)
+        if rows is not None:
+            done[k] = rows
     if progress:
         progress(sum(len(r) for r in done.values()))
     todo = [k for k in range(len(chunks)) if k not in done]
