@@ -5,6 +5,8 @@ refusal is one line on stderr, exit 2."""
 
 import json
 
+import pytest
+
 from bifilar.sweep import run as sweep_run
 from bifilar.sweep.space import load_space
 
@@ -41,3 +43,32 @@ def test_a_truncated_chunk_does_not_fail_the_command(tmp_path, capsys):
     code, out, err = _cli(capsys, "sweep", path, "--out", tmp_path / "out", "--jobs", 1)
     assert code == 0 and "4 configurations" in out, err
     assert err.count("\n") == 1 and "000000.json is unreadable (truncated?): recomputing it" in err, err
+
+
+def test_an_unreachable_scheduler_is_exit_2_within_seconds(tmp_path):
+    """In a process of its own, so that the wall time counts the imports and Dask's shutdown too."""
+    import subprocess
+    import sys
+    import time
+
+    path = _write(tmp_path, SPACE)
+    start = time.perf_counter()
+    done = subprocess.run([sys.executable, "-m", "validate", "sweep", str(path), "--out", str(tmp_path / "out"),
+                           "--scheduler", "tcp://127.0.0.1:1"], capture_output=True, text=True, timeout=60)
+    seconds = time.perf_counter() - start
+    assert done.returncode == 2 and done.stdout == "", done.stderr
+    assert done.stderr == "error: sweep: --scheduler tcp://127.0.0.1:1: cannot connect (timeout 5 s)\n"
+    assert seconds < 12, seconds
+    assert not (tmp_path / "out" / ".chunks").exists()
+
+
+@pytest.mark.parametrize("address, problem", [
+    ("", "empty"), ("  ", "empty"), ("nowhere", "not a scheduler address (missing port"),
+    ("xyz://a:1", "not a scheduler address (unknown address scheme"),
+])
+def test_a_malformed_or_empty_scheduler_is_refused_not_run_locally(tmp_path, capsys, address, problem):
+    path = _write(tmp_path, SPACE)
+    code, out, err = _cli(capsys, "sweep", path, "--out", tmp_path / "out", "--scheduler", address)
+    assert code == 2 and out == "" and err.count("\n") == 1, err
+    assert err.startswith("error: sweep: --scheduler ") and problem in err, err
+    assert not (tmp_path / "out" / "sweep.csv").exists()

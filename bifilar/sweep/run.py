@@ -29,6 +29,24 @@ from bifilar.sweep.space import Space, load_space
 # continued (~1 ms each), so chunks are long; but at least ~32 of them, to balance the workers. A pure
 # function of the grid's size, never of the executor: the rows are the same on any of them.
 MIN_CHUNK, MAX_CHUNK, CHUNKS = 64, 512, 32
+CONNECT_TIMEOUT = 5  # s: a Dask scheduler that has not answered by then is not there
+
+
+class Unreachable(Exception):
+    """The Dask scheduler cannot be used: a malformed address, or nothing answered in time."""
+
+
+def connect(address: str):
+    """A Dask client of the scheduler at ``address``, or :class:`Unreachable` within
+    :data:`CONNECT_TIMEOUT` (Dask's own default waits 30 s, then prints a traceback)."""
+    from dask.distributed import Client
+
+    try:
+        return Client(address, timeout=CONNECT_TIMEOUT)
+    except ValueError as exc:  # no port, unknown scheme
+        raise Unreachable(f"not a scheduler address ({exc})") from None
+    except (OSError, TimeoutError):
+        raise Unreachable(f"cannot connect (timeout {CONNECT_TIMEOUT} s)") from None
 
 
 def chunk_size(size: int) -> int:
@@ -109,6 +127,7 @@ def run(path: str, space: Space, out: Path, jobs: int = 1, scheduler: str | None
         chunk: int | None = None) -> list[dict]:
     """Every row of the sweep, in grid order, in chunks of ``chunk`` (default :func:`chunk_size`).
     ``progress(n_done)`` is called as chunks finish."""
+    client = connect(scheduler) if scheduler else None  # before any file is made: a bad address fails at once
     chunk = chunk_size(space.size) if chunk is None else chunk
     chunks = [(s, min(s + chunk, space.size)) for s in range(0, space.size, chunk)]
     folder = out / ".chunks" / digest(path, chunk)
@@ -129,10 +148,10 @@ def run(path: str, space: Space, out: Path, jobs: int = 1, scheduler: str | None
         if progress:
             progress(sum(len(r) for r in done.values()))
 
-    if scheduler:
-        from dask.distributed import Client, as_completed
+    if client is not None:
+        from dask.distributed import as_completed
 
-        with Client(scheduler) as client:
+        with client:
             futures = {client.submit(run_chunk, absolute, *chunks[k], pure=False): k for k in todo}
             for fut in as_completed(futures):
                 finish(futures[fut], fut.result())

@@ -26,7 +26,7 @@ import sys
 import time
 from pathlib import Path
 
-from ..argtypes import whole_number
+from ..argtypes import UsageError, whole_number
 
 COLUMNS_AFTER_AXES = (
     ["period_1", "period_2", "period_3", "period_4", "tension_1", "tension_2", "tension_peak",
@@ -150,12 +150,14 @@ def run(args) -> int:
     import os
     import shutil
 
-    from bifilar.sweep.run import run as run_sweep
+    from bifilar.sweep.run import Unreachable, run as run_sweep
     from bifilar.sweep.space import load_space
 
     from ..trajectory import atomic_write_text, check_writable
 
     out = Path(args.out)
+    if args.scheduler is not None and not args.scheduler.strip():  # not a quiet fall-back to local processes
+        raise UsageError(f"sweep: --scheduler {args.scheduler!r}: empty; give the address, e.g. tcp://127.0.0.1:8786")
     if args.rerun:
         check_writable(out / "sweep.rrd")  # a bad path fails now, not after the sweep
     space = load_space(args.space)
@@ -174,6 +176,8 @@ def run(args) -> int:
         progress = None
     try:
         rows = run_sweep(args.space, space, out, jobs=jobs, scheduler=args.scheduler, progress=progress)
+    except Unreachable as exc:
+        raise UsageError(f"sweep: --scheduler {args.scheduler}: {exc}") from None
     finally:
         if bar is not None:
             bar.close()
