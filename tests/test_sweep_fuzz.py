@@ -72,3 +72,23 @@ def test_a_malformed_or_empty_scheduler_is_refused_not_run_locally(tmp_path, cap
     assert code == 2 and out == "" and err.count("\n") == 1, err
     assert err.startswith("error: sweep: --scheduler ") and problem in err, err
     assert not (tmp_path / "out" / "sweep.csv").exists()
+
+
+def test_a_second_sweep_into_a_folder_in_use_refuses(tmp_path, capsys):
+    """The lock held here, as a running sweep holds it: the sweep refuses in one line and touches
+    nothing; once released, the same command runs, and leaves the lock free."""
+    import fcntl
+
+    path = _write(tmp_path, SPACE)
+    out = tmp_path / "out"
+    out.mkdir()
+    with open(out / ".lock", "a") as held:
+        fcntl.flock(held, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        code, stdout, err = _cli(capsys, "sweep", path, "--out", out, "--jobs", 1)
+        assert code == 2 and stdout == "", err
+        assert err == f"error: sweep: {out} is in use by another sweep (lock {out / '.lock'})\n"
+        assert sorted(p.name for p in out.iterdir()) == [".lock"]
+    code, stdout, err = _cli(capsys, "sweep", path, "--out", out, "--jobs", 1)
+    assert code == 0 and (out / "sweep.csv").exists(), err
+    with open(out / ".lock", "a") as again:
+        fcntl.flock(again, fcntl.LOCK_EX | fcntl.LOCK_NB)  # released: no BlockingIOError

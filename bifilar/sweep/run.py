@@ -9,6 +9,7 @@ reuses the saved chunks of the same sweep file (checked by a digest of its conte
 
 from __future__ import annotations
 
+import fcntl
 import hashlib
 import json
 import math
@@ -47,6 +48,24 @@ def connect(address: str):
         raise Unreachable(f"not a scheduler address ({exc})") from None
     except (OSError, TimeoutError):
         raise Unreachable(f"cannot connect (timeout {CONNECT_TIMEOUT} s)") from None
+
+
+class InUse(Exception):
+    """Another sweep holds the output folder's lock (the message is the lock file)."""
+
+
+def lock(out: Path):
+    """The open lock file ``out/.lock``, locked exclusively (``with`` it: released on close, and by the
+    system when its process ends, however it ends), or :class:`InUse` at once: two sweeps into one
+    folder would resume from and delete each other's chunks and overwrite each other's outputs."""
+    path = out / ".lock"
+    held = open(path, "a")
+    try:
+        fcntl.flock(held, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except BlockingIOError:
+        held.close()
+        raise InUse(str(path)) from None
+    return held
 
 
 def chunk_size(size: int) -> int:

@@ -147,13 +147,10 @@ def figure(space, rows: list[dict], path: Path) -> None:
 
 
 def run(args) -> int:
-    import os
-    import shutil
-
-    from bifilar.sweep.run import Unreachable, run as run_sweep
+    from bifilar.sweep.run import InUse, lock
     from bifilar.sweep.space import load_space
 
-    from ..trajectory import atomic_write_text, check_writable
+    from ..trajectory import check_writable
 
     out = Path(args.out)
     if args.scheduler is not None and not args.scheduler.strip():  # not a quiet fall-back to local processes
@@ -162,6 +159,22 @@ def run(args) -> int:
         check_writable(out / "sweep.rrd")  # a bad path fails now, not after the sweep
     space = load_space(args.space)
     out.mkdir(parents=True, exist_ok=True)
+    try:
+        held = lock(out)
+    except InUse as exc:
+        raise UsageError(f"sweep: {out} is in use by another sweep (lock {exc})") from None
+    with held:  # the whole sweep: chunks, outputs and their clean-up
+        return _sweep(args, space, out)
+
+
+def _sweep(args, space, out: Path) -> int:
+    import os
+    import shutil
+
+    from bifilar.sweep.run import Unreachable, run as run_sweep
+
+    from ..trajectory import atomic_write_text
+
     jobs = args.jobs or os.cpu_count() or 1
     start = time.perf_counter()
     bar = None
