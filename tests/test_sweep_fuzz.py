@@ -92,3 +92,21 @@ def test_a_second_sweep_into_a_folder_in_use_refuses(tmp_path, capsys):
     assert code == 0 and (out / "sweep.csv").exists(), err
     with open(out / ".lock", "a") as again:
         fcntl.flock(again, fcntl.LOCK_EX | fcntl.LOCK_NB)  # released: no BlockingIOError
+
+
+@pytest.mark.parametrize("space, field, value", [
+    ('[vary]\nwire_length = [1e300]\n', "vary.wire_length", "1e+300"),
+    ('[vary]\nwire_length = {from = 1.0, to = 2000.0, steps = 3}\n', "vary.wire_length", "2000"),
+    ('[vary]\nwire_length = [1.0]\nwire_length_2 = [1e-4, 1.0]\n', "vary.wire_length_2", "0.0001"),
+    ('[vary]\naxial_stiffness = [1e20]\n', "vary.axial_stiffness", "1e+20"),
+    ('[vary]\nanchor_span = [1.0, 1e5]\n', "vary.anchor_span", "100000"),
+    ('[vary]\nattach_height = [-1e6, 0.0]\n', "vary.attach_height", "-1e+06"),
+    ('[[point]]\nwire_length = 1.0\n[[point]]\nwire_length = 1e300\n', "point[2].wire_length", "1e+300"),
+])
+def test_axis_values_outside_the_rig_files_ranges_are_errors(tmp_path, capsys, space, field, value):
+    """As docs/sweep.md says: the limits a rig file's fields get (bifilar.rig.ranges), one line naming
+    the sweep file, the axis and the value; not a grid of infeasible rows."""
+    path = _write(tmp_path, 'rig = "rig.toml"\n' + space + '[measure]\naxes = ["z"]\n')
+    code, out, err = _cli(capsys, "sweep", path, "--out", tmp_path / "out", "--jobs", 1)
+    assert code == 2 and out == "" and err.count("\n") == 1, err
+    assert err.startswith(f"error: {path}: {field}: {value} is outside the rig file's ranges ("), err
