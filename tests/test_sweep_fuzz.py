@@ -27,7 +27,7 @@ def test_a_truncated_chunk_is_named_and_recomputed(tmp_path, capsys):
     folder.mkdir(parents=True)
     whole = json.dumps(sweep_run.run_chunk(str(path), 0, 2))
     (folder / "000000.json").write_text(whole)
-    (folder / "000001.json").write_text(whole[: len(whole) // 2])  # killed mid-write (before the rename)
+    (folder / "000001.json").write_text(whole[: len(whole) // 2])  # a crash before the data reached the disk
     rows = sweep_run.run(str(path), space, tmp_path / "out", jobs=1, chunk=2)
     assert json.dumps(rows) == json.dumps(clean)
     err = capsys.readouterr().err

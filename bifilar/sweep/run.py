@@ -4,7 +4,9 @@ The grid is cut into chunks of consecutive configurations (grid order, the last 
 neighbours follow each other and each rest pose continues from the previous one's). A chunk is a pure
 function of the sweep file and its index range, so any executor gives identical rows. Each finished
 chunk is saved whole (temp + rename) under ``DIR/.chunks/``; a restarted sweep with the same ``--out``
-reuses the saved chunks of the same sweep file (checked by a digest of its contents) and runs the rest.
+reuses the saved chunks of the same sweep file (checked by a digest of its contents) and runs the rest;
+a saved chunk that cannot be read back (a crash before its data reached the disk, a full disk) is named
+and recomputed.
 """
 
 from __future__ import annotations

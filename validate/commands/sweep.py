@@ -13,7 +13,8 @@ runs the K best configurations in MuJoCo (:mod:`validate.studies.sweep_check`) a
 disagreement over 1e-6. ``--png`` adds ``DIR/sweep.png``:
 the objective over the two most varied axes (the best over the others), infeasible points marked, and the
 Pareto front; ``--rerun`` adds ``DIR/sweep.rrd``, the table and the check's motions
-(:mod:`validate.studies.sweep_record`). The evaluation is :mod:`bifilar.sweep`.
+(:mod:`validate.studies.sweep_record`). The evaluation is :mod:`bifilar.sweep`. ``DIR/.lock`` is held
+for the whole run: a second sweep into ``DIR`` meanwhile is refused (exit 2).
 """
 
 from __future__ import annotations
