@@ -4,16 +4,20 @@ The grid is cut into chunks of consecutive configurations (grid order, the last 
 neighbours follow each other and each rest pose continues from the previous one's). A chunk is a pure
 function of the sweep file and its index range, so any executor gives identical rows. Each finished
 chunk is saved whole (temp + rename) under ``DIR/.chunks/``; a restarted sweep with the same ``--out``
-reuses the saved chunks of the same sweep file (checked by a digest of its contents) and runs the rest.
+reuses the saved chunks of the same sweep file (checked by a digest of its contents) and runs the rest;
+a saved chunk that cannot be read back (a crash before its data reached the disk, a full disk) is named
+and recomputed.
 """
 
 from __future__ import annotations
 
+import fcntl
 import hashlib
 import json
 import math
 import os
 import pickle
+import sys
 import tempfile
 from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
@@ -28,6 +32,42 @@ from bifilar.sweep.space import Space, load_space
 # continued (~1 ms each), so chunks are long; but at least ~32 of them, to balance the workers. A pure
 # function of the grid's size, never of the executor: the rows are the same on any of them.
 MIN_CHUNK, MAX_CHUNK, CHUNKS = 64, 512, 32
+CONNECT_TIMEOUT = 5  # s: a Dask scheduler that has not answered by then is not there
+
+
+class Unreachable(Exception):
+    """The Dask scheduler cannot be used: a malformed address, or nothing answered in time."""
+
+
+def connect(address: str):
+    """A Dask client of the scheduler at ``address``, or :class:`Unreachable` within
+    :data:`CONNECT_TIMEOUT` (Dask's own default waits 30 s, then prints a traceback)."""
+    from dask.distributed import Client
+
+    try:
+        return Client(address, timeout=CONNECT_TIMEOUT)
+    except ValueError as exc:  # no port, unknown scheme
+        raise Unreachable(f"not a scheduler address ({exc})") from None
+    except (OSError, TimeoutError):
+        raise Unreachable(f"cannot connect (timeout {CONNECT_TIMEOUT} s)") from None
+
+
+class InUse(Exception):
+    """Another sweep holds the output folder's lock (the message is the lock file)."""
+
+
+def lock(out: Path):
+    """The open lock file ``out/.lock``, locked exclusively (``with`` it: released on close, and by the
+    system when its process ends, however it ends), or :class:`InUse` at once: two sweeps into one
+    folder would resume from and delete each other's chunks and overwrite each other's outputs."""
+    path = out / ".lock"
+    held = open(path, "a")
+    try:
+        fcntl.flock(held, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except BlockingIOError:
+        held.close()
+        raise InUse(str(path)) from None
+    return held
 
 
 def chunk_size(size: int) -> int:
@@ -87,19 +127,37 @@ def _save(folder: Path, name: str, rows: list[dict]) -> None:
     os.replace(tmp, folder / name)
 
 
+def _load(f: Path, size: int) -> list[dict] | None:
+    """The rows saved in chunk file ``f`` (``size`` of them), or None if there is none. A file that is
+    not such a list (truncated or garbled by a killed run or a full disk) is named on stderr and
+    deleted, so that its chunk is recomputed rather than every rerun failing on it."""
+    if not f.exists():
+        return None
+    try:
+        rows = json.loads(f.read_text())
+        if isinstance(rows, list) and len(rows) == size and all(isinstance(r, dict) for r in rows):
+            return rows
+    except (OSError, ValueError):  # JSONDecodeError and UnicodeDecodeError are ValueErrors
+        pass
+    print(f"sweep: {f} is unreadable (truncated?): recomputing it", file=sys.stderr, flush=True)
+    f.unlink(missing_ok=True)
+    return None
+
+
 def run(path: str, space: Space, out: Path, jobs: int = 1, scheduler: str | None = None, progress=None,
         chunk: int | None = None) -> list[dict]:
     """Every row of the sweep, in grid order, in chunks of ``chunk`` (default :func:`chunk_size`).
     ``progress(n_done)`` is called as chunks finish."""
+    client = connect(scheduler) if scheduler else None  # before any file is made: a bad address fails at once
     chunk = chunk_size(space.size) if chunk is None else chunk
     chunks = [(s, min(s + chunk, space.size)) for s in range(0, space.size, chunk)]
     folder = out / ".chunks" / digest(path, chunk)
     folder.mkdir(parents=True, exist_ok=True)
     done: dict[int, list[dict]] = {}
-    for k in range(len(chunks)):
-        f = folder / f"{k:06d}.json"
-        if f.exists():
-            done[k] = json.loads(f.read_text())
+    for k, (start, stop) in enumerate(chunks):
+        rows = _load(folder / f"{k:06d}.json", stop - start)
+        if rows is not None:
+            done[k] = rows
     if progress:
         progress(sum(len(r) for r in done.values()))
     todo = [k for k in range(len(chunks)) if k not in done]
@@ -111,10 +169,10 @@ def run(path: str, space: Space, out: Path, jobs: int = 1, scheduler: str | None
         if progress:
             progress(sum(len(r) for r in done.values()))
 
-    if scheduler:
-        from dask.distributed import Client, as_completed
+    if client is not None:
+        from dask.distributed import as_completed
 
-        with Client(scheduler) as client:
+        with client:
             futures = {client.submit(run_chunk, absolute, *chunks[k], pure=False): k for k in todo}
             for fut in as_completed(futures):
                 finish(futures[fut], fut.result())

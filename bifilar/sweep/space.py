@@ -42,7 +42,8 @@ from bifilar.bodies.boat import load_suspension
 from bifilar.bodies.composite import Part
 from bifilar.rig import Rig, RigError, load_rig
 from bifilar.rig.checks import no_unknown, number, positive, read_toml, required, table
-from bifilar.sweep.axes import AXES, POSITIVE, attach_span_of
+from bifilar.rig.ranges import check_ranges
+from bifilar.sweep.axes import AXES, POSITIVE, attach_span_of, configure
 
 MAX_POINTS = 10**7  # a larger grid is a mistake: 10^7 configurations take hours even at 1000/s
 MAX_STEPS = 10**6  # per axis
@@ -130,6 +131,11 @@ def _check_axis(rig: Rig, name: str, values: np.ndarray, src: str, field: str) -
         if values.min() < 0.0 or values.max() >= half:
             raise RigError(src, field, f"must be from 0 to under half the base rig's attachment span ({half:g} m); "
                                        f"found {values.min():g} to {values.max():g}")
+    for value in sorted({float(values.min()), float(values.max())}):
+        try:  # the rig file's ranges (bifilar.rig.ranges), on the base rig with this axis at this value
+            check_ranges(configure(rig, {name: value}))
+        except RigError as exc:
+            raise RigError(src, field, f"{value:g} is outside the rig file's ranges ({exc.field}: {exc.problem})") from None
 
 
 def _points(raw, src: str) -> tuple[dict[str, np.ndarray], tuple]:

@@ -13,7 +13,8 @@ runs the K best configurations in MuJoCo (:mod:`validate.studies.sweep_check`) a
 disagreement over 1e-6. ``--png`` adds ``DIR/sweep.png``:
 the objective over the two most varied axes (the best over the others), infeasible points marked, and the
 Pareto front; ``--rerun`` adds ``DIR/sweep.rrd``, the table and the check's motions
-(:mod:`validate.studies.sweep_record`). The evaluation is :mod:`bifilar.sweep`.
+(:mod:`validate.studies.sweep_record`). The evaluation is :mod:`bifilar.sweep`. ``DIR/.lock`` is held
+for the whole run: a second sweep into ``DIR`` meanwhile is refused (exit 2).
 """
 
 from __future__ import annotations
@@ -26,7 +27,7 @@ import sys
 import time
 from pathlib import Path
 
-from ..argtypes import whole_number
+from ..argtypes import UsageError, whole_number
 
 COLUMNS_AFTER_AXES = (
     ["period_1", "period_2", "period_3", "period_4", "tension_1", "tension_2", "tension_peak",
@@ -147,19 +148,34 @@ def figure(space, rows: list[dict], path: Path) -> None:
 
 
 def run(args) -> int:
-    import os
-    import shutil
-
-    from bifilar.sweep.run import run as run_sweep
+    from bifilar.sweep.run import InUse, lock
     from bifilar.sweep.space import load_space
 
-    from ..trajectory import atomic_write_text, check_writable
+    from ..trajectory import check_writable
 
     out = Path(args.out)
+    if args.scheduler is not None and not args.scheduler.strip():  # not a quiet fall-back to local processes
+        raise UsageError(f"sweep: --scheduler {args.scheduler!r}: empty; give the address, e.g. tcp://127.0.0.1:8786")
     if args.rerun:
         check_writable(out / "sweep.rrd")  # a bad path fails now, not after the sweep
     space = load_space(args.space)
     out.mkdir(parents=True, exist_ok=True)
+    try:
+        held = lock(out)
+    except InUse as exc:
+        raise UsageError(f"sweep: {out} is in use by another sweep (lock {exc})") from None
+    with held:  # the whole sweep: chunks, outputs and their clean-up
+        return _sweep(args, space, out)
+
+
+def _sweep(args, space, out: Path) -> int:
+    import os
+    import shutil
+
+    from bifilar.sweep.run import Unreachable, run as run_sweep
+
+    from ..trajectory import atomic_write_text
+
     jobs = args.jobs or os.cpu_count() or 1
     start = time.perf_counter()
     bar = None
@@ -174,6 +190,8 @@ def run(args) -> int:
         progress = None
     try:
         rows = run_sweep(args.space, space, out, jobs=jobs, scheduler=args.scheduler, progress=progress)
+    except Unreachable as exc:
+        raise UsageError(f"sweep: --scheduler {args.scheduler}: {exc}") from None
     finally:
         if bar is not None:
             bar.close()
