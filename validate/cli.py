@@ -440,7 +440,8 @@ def _cmd_list(args) -> int:
         tags = ",".join(sorted(c.tags))
         print(f"{c.name}  [{tags}]  {c.source}")
         text = " ".join(c.description.split())
-        print(textwrap.fill(text, width=100, initial_indent="    ", subsequent_indent="    ") if text else "    -")
+        print(textwrap.fill(text, width=100, initial_indent="    ", subsequent_indent="    ",
+                            break_on_hyphens=False) if text else "    -")
     return OK
 
 
