@@ -156,3 +156,34 @@ def test_plan_beats_the_textbook_hangings(tmp_path, capsys):
     (tmp_path / "c.toml").write_text('rig = "rig.toml"\ngenerate = 80\n')
     assert main(["plan", str(tmp_path / "c.toml"), "--count", "6"]) == 2
     assert "period_std: missing" in capsys.readouterr().err
+
+
+def test_hangings_from_records_and_a_tare_from_its_record(tmp_path, capsys):
+    # Seven laser-spot records (pixels, scale unknown, --max-amplitude) through the hangings file:
+    # each component within 4 of its stated sigmas (a record fit's sigma, not an exact period).
+    from bifilar.identification.records import synthetic as Y
+    from validate.cases.tensor import LASER_OPTIONS, hanging_record, write_record_hangings
+
+    path = write_record_hangings(tmp_path, np.random.default_rng(3), Y.laser, LASER_OPTIONS)
+    report = _json(capsys, ["tensor", path, "--json"])
+    z = (np.array(report["tensor"]) - TRUE_INERTIA) / np.array(report["tensor_std"])
+    assert np.abs(z).max() < 4.0, z
+    assert all(h["period_source"] == "1 record(s)" for h in report["hangings"])
+    # The tare from a 250 Hz gyro record of the disc alone (rad/s; a careful one: 0.3 rad, 40 cycles, no
+    # other mode, since the object is 2 % of the disc's moment): its moment within 4 sigma of the disc's,
+    # and the object's tensor from exact assembly periods within 4 of its sigmas.
+    disc = rig("trifilar")
+    rec = hanging_record(replace(disc, initial_rotation=np.zeros(3)), np.random.default_rng(4),
+                         Y.gyro(np.random.default_rng(4), rate=250.0, cycles=40.0, amplitude=0.3,
+                                                               second=None))
+    (tmp_path / "disc.csv").write_text("t,rate\n" + "".join(f"{t:.6f},{v:.6f}\n" for t, v in zip(rec.t, rec.y)))
+    periods = [linear_period(assembly(e)[0], "z") for e in SEVEN]
+    path = write_tare_hangings(tmp_path, periods, 2.0, 1e-6)
+    text = open(path).read().replace("period = 2.0 }", 'signal = ["disc.csv"], kind = "rate", column = "rate" }')
+    open(path, "w").write(text)
+    report = _json(capsys, ["tensor", path, "--json"])
+    (tare,) = report["tares"]
+    assert abs(tare["moment"] - disc.inertia[2, 2]) < 4.0 * tare["moment_std"]
+    assert tare["period_source"] == "1 record(s)"
+    z = (np.array(report["tensor"]) - OBJECT_INERTIA) / np.array(report["tensor_std"])
+    assert np.abs(z).max() < 4.0, z

@@ -24,7 +24,7 @@ The file holds ``[[hanging]]`` tables (docs/identification.md section 8 gives ev
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
@@ -277,19 +277,17 @@ def _body_inertia(data: dict, src: str) -> np.ndarray | None:
     return rig.inertia
 
 
-def _rig(data: dict, src: str, mass: float | None = None, com=None, inertia=None) -> Rig:
-    """The rig of a parsed file with its [body] mass, COM and inertia replaced where given."""
+def _rig(data: dict, src: str, com=None, inertia=None) -> Rig:
+    """The rig of a parsed file (checked as a rig file, a nan inertia read as a stand-in), then with its
+    COM and inertia replaced where given. The replaced tensor is a model's (a thin platform's, held, plus
+    an object's guess) and is not held to a rig file's checks: only the fitted object's tensor is."""
     body = dict(data.get("body") or {})
-    if mass is not None:
-        body["mass"] = mass
-    if com is not None:
-        body["com"] = [float(c) for c in com]
-    if inertia is not None:
-        body["inertia"] = [[float(v) for v in row] for row in inertia]
-    elif any(isinstance(v, float) and math.isnan(v) for v in np.ravel(np.array(body.get("inertia", []), dtype=object))):
+    if any(isinstance(v, float) and math.isnan(v) for v in np.ravel(np.array(body.get("inertia", []), dtype=object))):
         m = positive(required(body, "mass", src, "body."), src, "body.mass")
         body["inertia"] = [_PLACEHOLDER * m] * 3
-    return rig_from_dict({**data, "body": body}, src)
+    rig = rig_from_dict({**data, "body": body}, src)
+    return replace(rig, com=rig.com if com is None else np.asarray(com, float),
+                   inertia=rig.inertia if inertia is None else np.asarray(inertia, float))
 
 
 def _measure_fixture(t: _Tare) -> Fixture:
