@@ -49,7 +49,12 @@ WEAK_SENSITIVITY = 0.02  # d ln T / d ln I below this: the period barely depends
 def add_parser(subparsers) -> None:
     """Register the ``identify`` subcommand on the CLI's subparsers."""
 
-    p = subparsers.add_parser("identify", help="a moment of inertia from measured periods or records, with its uncertainty")
+    from ..statuses import epilog
+
+    p = subparsers.add_parser("identify", help="a moment of inertia from measured periods or records, with its uncertainty",
+                              epilog=epilog("identify", (
+                                  "python -m validate identify bench_plate --axis z --period 1.5 --json",
+                                  "python -m validate identify bench_plate --axis z --signal video.csv --fps 60")))
     p.add_argument("rig", help="rig file (TOML) holding the body as hung; the unknown moment may be nan there")
     p.add_argument("--axis", required=True, choices=("x", "y", "z"), help="body axis of the unknown moment")
     source = p.add_mutually_exclusive_group(required=True)
@@ -79,7 +84,7 @@ def add_parser(subparsers) -> None:
     tare = p.add_mutually_exclusive_group()
     tare.add_argument("--tare-period", type=positive_float("--tare-period"), help="the fixture's period, s")
     tare.add_argument("--tare-signal", metavar="FILE", action="append", help="a record of the fixture alone")
-    p.add_argument("--samples", type=whole_number("--samples", 100), help="Monte Carlo draws instead of linear propagation")
+    p.add_argument("--samples", type=whole_number("--samples", 100), help="Monte Carlo draws instead of linear propagation, at least 100 (default: none, linear propagation)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.add_argument("--png", metavar="FILE.png", help="draw each record, its fit, residuals and period against amplitude")
     p.add_argument("--html", metavar="FILE.html", help="write one self-contained page: the result, the fits, the "
