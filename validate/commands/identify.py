@@ -84,7 +84,8 @@ def add_parser(subparsers) -> None:
     tare = p.add_mutually_exclusive_group()
     tare.add_argument("--tare-period", type=positive_float("--tare-period"), help="the fixture's period, s")
     tare.add_argument("--tare-signal", metavar="FILE", action="append", help="a record of the fixture alone")
-    p.add_argument("--samples", type=whole_number("--samples", 100), help="Monte Carlo draws instead of linear propagation, at least 100 (default: none, linear propagation)")
+    p.add_argument("--samples", type=whole_number("--samples", 100),
+                   help="Monte Carlo draws instead of linear propagation, at least 100 (default: none, linear propagation)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.add_argument("--png", metavar="FILE.png", help="draw each record, its fit, residuals and period against amplitude")
     p.add_argument("--html", metavar="FILE.html", help="write one self-contained page: the result, the fits, the "
