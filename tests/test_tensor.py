@@ -187,3 +187,19 @@ def test_hangings_from_records_and_a_tare_from_its_record(tmp_path, capsys):
     assert tare["period_source"] == "1 record(s)"
     z = (np.array(report["tensor"]) - OBJECT_INERTIA) / np.array(report["tensor_std"])
     assert np.abs(z).max() < 4.0, z
+
+
+def test_a_tare_with_unknown_moments_is_taken_as_a_flat_platform(tmp_path, capsys):
+    # The trifilar disc is a flat platform (I_xx = I_yy = I_zz / 2 to 1e-3: it is 2 cm thick): a tare
+    # file with all three moments nan measures I_zz and takes the others as half of it, says so, and
+    # the object's tensor still comes back to 1e-5 of its largest component (the platform's tilt
+    # moments enter the yaw only through the COM offsets, a few mm here).
+    periods = [linear_period(assembly(e)[0], "z") for e in SEVEN]
+    path = write_tare_hangings(tmp_path, periods, linear_period(rig("trifilar"), "z"), 1e-6, 1e-6)
+    platform = tmp_path / "platform.toml"
+    text = platform.read_text()
+    start = text.index("inertia = [")
+    platform.write_text(text[:start] + "inertia = [nan, nan, nan]" + text[text.index("\n", start):])
+    report = _json(capsys, ["tensor", path, "--json"])
+    assert sum("taken as a flat platform's" in f for f in report["flags"]) == 2
+    np.testing.assert_allclose(report["tensor"], OBJECT_INERTIA, rtol=0, atol=1e-5 * 0.0025)

@@ -71,6 +71,7 @@ class Fixture:
     std: float
     measured: Measured
     key: tuple
+    assumed: tuple[int, ...] = ()  # body axes whose moment the file left nan: taken as a flat platform's
 
 
 @dataclass
@@ -119,6 +120,8 @@ def read_hangings(path: str | Path) -> Setup:
     tares = tuple(Tare(f.axis, f.std) for f in fixtures.values())
     flags = [f"{e.label}: {flag}" for e, m in zip(entries, measured) for tr in m.trials for flag in tr.flags]
     flags += [f"tare {f.rig.source}: {flag}" for f in fixtures.values() for tr in f.measured.trials for flag in tr.flags]
+    flags += [f"tare {f.rig.source}: I_{'xy'[i]}{'xy'[i]} is nan there: taken as a flat platform's, I_zz / 2"
+              for f in fixtures.values() for i in f.assumed]
     return Setup(hangings, tares, list(fixtures.values()), measured, start, mass, com, flags)
 
 
@@ -292,30 +295,42 @@ def _rig(data: dict, src: str, com=None, inertia=None) -> Rig:
 
 def _measure_fixture(t: _Tare) -> Fixture:
     data = read_toml(t.path)
-    rig = _fixture_rig(data, str(t.path))
+    rig, unknown = _fixture_rig(data, str(t.path))
     axis = _vertical(rig)
     measured = _measure_period(rig, axis, t.period, t.period_std, t.signals, t.options, 0.0)
     found = invert_period(rig, axis, measured.period)
     std = found.moment * measured.std / measured.period / found.sensitivity
-    return Fixture(found.rig, axis, found.moment, std, measured, t.key)
+    fixture = found.rig
+    if unknown:  # a flat platform: I_xx = I_yy = I_zz / 2 where the file does not say
+        inertia = fixture.inertia.copy()
+        for i in unknown:
+            inertia[i, i] = 0.5 * found.moment
+        fixture = replace(fixture, inertia=inertia)
+    return Fixture(fixture, axis, found.moment, std, measured, t.key, tuple(unknown))
 
 
-def _fixture_rig(data: dict, src: str) -> Rig:
-    """The fixture's rig; a nan moment about z (the one its period measures) starts at the mean of
-    the other two diagonal entries."""
+def _fixture_rig(data: dict, src: str) -> tuple[Rig, list[int]]:
+    """The fixture's rig and the indices of its unknown (nan) I_xx, I_yy. The moment its period
+    measures, I_zz, may be nan (a start value then: the mean of the others, or a stand-in), and so
+    may I_xx and I_yy (then taken as a flat platform's, I_zz / 2: they enter only through the
+    platform's tilt)."""
     body = dict(data.get("body") or {})
     value = body.get("inertia")
-    if isinstance(value, list) and len(value) == 3 and not isinstance(value[0], list):
-        if isinstance(value[2], float) and math.isnan(value[2]):
-            body["inertia"] = [value[0], value[1], 0.5 * (number(value[0], src, "body.inertia[0]")
-                                                         + number(value[1], src, "body.inertia[1]"))]
-    elif isinstance(value, list) and len(value) == 3 and isinstance(value[2], list) and len(value[2]) == 3:
-        if isinstance(value[2][2], float) and math.isnan(value[2][2]):
-            rows = [list(r) for r in value]
-            rows[2][2] = 0.5 * (number(rows[0][0], src, "body.inertia[0][0]") + number(rows[1][1], src,
-                                                                                       "body.inertia[1][1]"))
-            body["inertia"] = rows
-    return rig_from_dict({**data, "body": body}, src)
+    if isinstance(value, list) and len(value) == 3 and all(isinstance(r, list) and len(r) == 3 for r in value):
+        cells = [[value[i][k] for k in range(3)] for i in range(3)]
+    elif isinstance(value, list) and len(value) == 3:
+        cells = [[value[i] if i == k else 0.0 for k in range(3)] for i in range(3)]
+    else:
+        return rig_from_dict(data, src), []  # its own one-line error
+    nan = [i for i in range(3) if isinstance(cells[i][i], float) and math.isnan(cells[i][i])]
+    if nan:
+        mass = positive(required(body, "mass", src, "body."), src, "body.mass")
+        known = [number(cells[i][i], src, f"body.inertia[{i}]") for i in (0, 1) if i not in nan]
+        zz = cells[2][2] if 2 not in nan else (sum(known) / len(known) if known else _PLACEHOLDER * mass)
+        for i in nan:
+            cells[i][i] = zz if i == 2 else 0.5 * number(zz, src, "body.inertia[2]")
+        body["inertia"] = cells
+    return rig_from_dict({**data, "body": body}, src), [i for i in nan if i != 2]
 
 
 def _measure_period(rig: Rig, axis, period, period_std, signals, options, amplitude) -> Measured:
