@@ -46,6 +46,7 @@ _RECORD_KEYS = {"column", "kind", "time_column", "fps", "time_unit", "angle_unit
 _HANGING_KEYS = {"rig", "orientation", "period", "period_std", "amplitude", "signal", "tare", "name"} | _RECORD_KEYS
 _TARE_KEYS = {"rig", "period", "period_std", "signal"} | _RECORD_KEYS
 _PLACEHOLDER = 1e-2  # m^2 x mass: an isotropic stand-in for an unknown inertia while the rig is read
+_GUESSES = (0.5, 0.2, 1.0, 0.05, 2.0)  # x m r^2: a first pass's isotropic guesses, most likely first
 _ROTATION_TOL = 1e-6  # |Q^T Q - 1| and |det Q - 1| of a given matrix
 _SAME_MASS = 1e-3  # relative: objects whose masses differ by more are not the same object
 _SAME_COM = 1e-3  # x rig size: the same for the COM
@@ -109,11 +110,13 @@ def read_hangings(path: str | Path) -> Setup:
     mass, com = _object_body(entries, fixtures, src)
     held = [_held(e, fixtures.get(e.tare.key) if e.tare else None, mass) for e in entries]
     start = _given_start(entries)
-    measured = [_measure(e, h, start if start is not None else _PLACEHOLDER * mass * np.eye(3))
-                for e, h in zip(entries, held)]
-    if start is None:  # the records' amplitude law depends on the inertia: refit them at a real start
+    if start is not None:
+        measured = [_measure(e, h, start) for e, h in zip(entries, held)]
+    else:  # the amplitude law depends on the inertia: a first pass at guesses, then all at a real start
+        measured = [_first_pass(e, h, mass) for e, h in zip(entries, held)]
         start = _start_from_periods(entries, held, measured, mass)
-        measured = [_measure(e, h, start) if e.signals else m for e, h, m in zip(entries, held, measured)]
+        measured = [_measure(e, h, start) if e.signals or e.amplitude else m
+                    for e, h, m in zip(entries, held, measured)]
     hangings = [Hanging(_hung(e, h, start), m.period, m.std, e.orientation, h,
                         keys.index(e.tare.key) if e.tare else None, e.label)
                 for e, h, m in zip(entries, held, measured)]
@@ -420,6 +423,23 @@ def _measure(e: _Entry, held: np.ndarray, x: np.ndarray) -> Measured:
         return _measure_period(rig, axis, e.period, e.period_std, e.signals, e.options, e.amplitude)
     except RigError as exc:
         raise RigError(exc.source, exc.field, f"{exc.problem} ({e.label})") from None
+
+
+def _first_pass(e: _Entry, held: np.ndarray, mass: float) -> Measured:
+    """The hanging measured with the object's tensor unknown: isotropic guesses f m r^2 (r the
+    attachments' mean distance from the COM's vertical) in turn, from a disc's f = 1/2, until the
+    records fit (at a large swing a wrong guess gives a law the record does not follow)."""
+    rig = _hung(e, held, _PLACEHOLDER * mass * np.eye(3))
+    vertical = _vertical(rig)
+    arms = np.array([w.attach - rig.com for w in rig.wires])
+    radius2 = float(np.mean(np.sum(arms ** 2, axis=1) - (arms @ vertical) ** 2))
+    problem = None
+    for f in _GUESSES:
+        try:
+            return _measure(e, held, f * mass * radius2 * np.eye(3))
+        except RigError as exc:
+            problem = problem or exc
+    raise problem
 
 
 def _given_start(entries: list[_Entry]) -> np.ndarray | None:
