@@ -78,7 +78,9 @@ def test_every_csv_field_against_an_independent_computation(tmp_path, capsys):
         "../../models/rigs/bench_plate.toml", str((__import__("pathlib").Path(__file__).parents[1] / "models/rigs/bench_plate.toml").resolve())))
     code, out, err = _cli(capsys, "sweep", path, "--out", tmp_path / "out", "--jobs", 1)
     assert code == 0, err
-    assert out.count("\n") == 1 and "4 configurations" in out
+    # one summary (wrapped at 100 columns, continuations indented), no edge warning on a 2 x 2 grid
+    assert out.startswith("sweep space.toml: 4 configurations") and "warning" not in out
+    assert all(len(line) <= 100 and (k == 0 or line.startswith("  ")) for k, line in enumerate(out.splitlines()))
     rows = list(csv.DictReader(open(tmp_path / "out" / "sweep.csv")))
     assert list(rows[0])[:16] == ["wire_length", "attach_span", "period_1", "period_2", "period_3", "period_4",
                                   "tension_1", "tension_2", "tension_peak", "sigma_x", "sigma_y", "sigma_z",

@@ -38,3 +38,23 @@ def pareto(rows: list[dict], measured, kind: str) -> list[dict]:
             front.append(rows[i])
             lowest = tension
     return front
+
+
+def edges(axes: dict, top: dict | None, explicit: bool = False) -> list[dict]:
+    """Where the best row sits on the grid's edge: one entry per axis of three or more values whose
+    smallest or largest value the best takes (``axis``, ``side`` low/high, ``widen`` the direction to
+    extend the grid, ``text``). A best on an edge may only be the best inside the grid: widening it
+    there may move it. Explicit point lists have no grid, so no edges."""
+    if top is None or explicit:
+        return []
+    out = []
+    for name, values in axes.items():
+        if len(values) < 3:
+            continue
+        value = top["values"][name]
+        for side, end, widen in (("low", min(values), "below"), ("high", max(values), "above")):
+            if value == end:
+                out.append({"axis": name, "side": side, "widen": widen,
+                            "text": f"the best {name} = {value:g} is the grid's {'smallest' if side == 'low' else 'largest'}"
+                                    f" value: widen {name} {widen} {value:g} to see whether it is the best beyond the grid"})
+    return out

@@ -76,8 +76,15 @@ def csv_text(axes: list[str], rows: list[dict]) -> str:
     return buf.getvalue()
 
 
+def _wrap(text: str) -> str:
+    """A report line wrapped at 100 columns (continuations indented; paths and words kept whole)."""
+    import textwrap
+
+    return textwrap.fill(text, width=100, subsequent_indent="  ", break_on_hyphens=False, break_long_words=False)
+
+
 def summary(space, rows: list[dict], seconds: float) -> dict:
-    from bifilar.sweep.choose import best, objective, pareto
+    from bifilar.sweep.choose import best, edges, objective, pareto
 
     def point(r):
         return {**r["values"], "sigma": {a: r["sigma"][a] for a in space.measure},
@@ -90,6 +97,7 @@ def summary(space, rows: list[dict], seconds: float) -> dict:
         "objective": f"{space.objective} relative sigma over {list(space.measure)}, feasible rows only",
         "best": point(top) if top else None,
         "pareto": [point(r) for r in pareto(rows, space.measure, space.objective)],
+        "edges": edges(space.axes, top, space.explicit),
         "seconds": seconds,
         "mujoco_check": [],
     }
@@ -103,7 +111,7 @@ def figure(space, rows: list[dict], path: Path) -> None:
     import matplotlib.pyplot as plt
     import numpy as np
 
-    from bifilar.sweep.choose import best, objective, pareto
+    from bifilar.sweep.choose import best, edges, objective, pareto
 
     axes = sorted(space.axes, key=lambda a: -len(space.axes[a]))[:2]
     fig, (left, right) = plt.subplots(1, 2, figsize=(11, 4.5))
@@ -124,6 +132,12 @@ def figure(space, rows: list[dict], path: Path) -> None:
         if top:
             left.scatter([top["values"][axes[0]]], [top["values"][axes[1]]], marker="*", s=200, color="white",
                          edgecolor="black", label="best")
+        hidden = [a for a in space.axes if a not in axes and len(space.axes[a]) > 1]
+        left.set_title("least over " + ", ".join(hidden) + " in each cell" if hidden else "every configuration",
+                       fontsize=9)
+        for k, edge in enumerate(edges(space.axes, top, space.explicit)):
+            left.annotate(f"best on the {edge['side']} edge of {edge['axis']}: widen {edge['widen']}",
+                          xy=(0.01, 0.01 + 0.05 * k), xycoords="axes fraction", fontsize=7, color="red")
         left.set_xlabel(f"{axes[0]} (m)")
         left.set_ylabel(f"{axes[1]} (m)")
         left.legend(loc="upper right", fontsize=8)
@@ -207,6 +221,8 @@ def _sweep(args, space, out: Path) -> int:
                         key=lambda r: objective(r, space.measure, space.objective))
         checked = check(space, [r["values"] for r in ranked[: args.check_mujoco]])
         data["mujoco_check"] = [c.entry for c in checked]
+    data["files"] = (["sweep.csv", "summary.json"] + (["sweep.png"] if args.png else []) + ["report.html"]
+                     + (["sweep.rrd"] if args.rerun else []))
     atomic_write_text(out / "sweep.csv", csv_text(list(space.axes), rows))
     atomic_write_text(out / "summary.json", json.dumps(data, indent=1, allow_nan=False) + "\n")
     if args.png:
@@ -224,10 +240,11 @@ def _sweep(args, space, out: Path) -> int:
     best_text = ("no feasible configuration" if top is None else
                  "best " + ", ".join(f"{a} = {top[a]:g}" for a in space.axes) + f": {space.objective} sigma "
                  f"{100 * top['objective']:.3g} %, peak tension {top['tension_peak']:.4g} N")
-    print(f"sweep {Path(args.space).name}: {data['n']} configurations, {data['feasible']} feasible, "
+    print(_wrap(f"sweep {Path(args.space).name}: {data['n']} configurations, {data['feasible']} feasible, "
           f"{seconds:.1f} s on {1 if args.scheduler is None and jobs == 1 else jobs} worker(s); {best_text}; "
-          f"wrote {out / 'sweep.csv'}, {out / 'summary.json'}, {out / 'report.html'}"
-          + (f", {out / 'sweep.rrd'}" if args.rerun else ""))
+          f"wrote {', '.join(str(out / f) for f in data['files'])}"))
+    for edge in data["edges"]:
+        print(_wrap(f"warning: {edge['text']}"))
     if data["mujoco_check"]:
         worst = max(c["period_rel_error"] for c in data["mujoco_check"])
         print(f"MuJoCo check of the {len(data['mujoco_check'])} best: largest period difference {worst:.2e}"
