@@ -339,6 +339,7 @@ def _trial(tr, mass: float) -> dict:
         "dropped": tr.record.dropped,
         "unfolded": tr.record.unfolded,
         "block": fit.block,
+        "jackknife": fit.jackknife,
         "flags": list(tr.flags),
     }
 
