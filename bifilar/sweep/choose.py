@@ -111,20 +111,6 @@ def best(rows, measured, kind: str) -> dict | None:
     return choice.best[1] if choice.best else None
 
 
-def pareto(rows: list[dict], measured, kind: str) -> list[dict]:
-    """Feasible rows not dominated in (objective, peak tension), by increasing objective."""
-    points = sorted(
-        ((objective(r, measured, kind), r["tension_peak"], i) for i, r in enumerate(rows)
-         if math.isfinite(objective(r, measured, kind))),
-    )
-    front, lowest = [], math.inf
-    for value, tension, i in points:
-        if tension < lowest:
-            front.append(rows[i])
-            lowest = tension
-    return front
-
-
 def edges(axes: dict, top: dict | None, explicit: bool = False) -> list[dict]:
     """Where the best row sits on the grid's edge: one entry per axis of three or more values whose
     smallest or largest value the best takes (``axis``, ``side`` low/high, ``widen`` the direction to
