@@ -10,14 +10,13 @@ MuJoCo periods (relative) and the mean-tension errors (themselves relative, so t
 
 from __future__ import annotations
 
-import math
 import os
 import sys
 import tempfile
 import time
 from pathlib import Path
 
-from bifilar.sweep.choose import objective
+from bifilar.sweep.choose import Choice
 from bifilar.sweep.run import run as run_sweep
 from bifilar.sweep.space import load_space
 from validate.assets import MODELS
@@ -26,11 +25,11 @@ from validate.studies.sweep_check import check
 
 def main(k: int, path: str) -> None:
     space = load_space(path)
+    choice = Choice(space.measure, space.objective, keep=k)
     with tempfile.TemporaryDirectory() as out:
-        rows = run_sweep(path, space, Path(out), jobs=os.cpu_count() or 1)
-    scored = sorted((objective(r, space.measure, space.objective), i) for i, r in enumerate(rows))
-    ranked = [rows[i] for value, i in scored if math.isfinite(value)][:k]
-    configurations = [r["values"] for r in ranked]
+        for row in run_sweep(path, space, Path(out), jobs=os.cpu_count() or 1).rows():
+            choice.add(row)
+    configurations = [r["values"] for _, r in choice.ranking.ranked()[:k]]
     start = time.perf_counter()
     sequential = check(space, configurations, batched=False)
     t_seq = time.perf_counter() - start

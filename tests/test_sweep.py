@@ -137,10 +137,11 @@ def test_dask_cluster_gives_the_local_rows_bit_for_bit_and_a_sweep_resumes(tmp_p
     path = _write(tmp_path, 'rig = "rig.toml"\n[vary]\nwire_length = {from = 1.0, to = 2.0, steps = 3}\n'
                             'attach_span = [0.3, 0.4]\n[measure]\naxes = ["z"]\n')
     space = load_space(path)
-    local = sweep_run.run(str(path), space, tmp_path / "a", jobs=1, chunk=2)
+    local = list(sweep_run.run(str(path), space, tmp_path / "a", jobs=1, chunk=2).rows())
     with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1",
                       dashboard_address=None) as cluster, Client(cluster):
-        remote = sweep_run.run(str(path), space, tmp_path / "b", scheduler=cluster.scheduler_address, chunk=2)
+        remote = list(sweep_run.run(str(path), space, tmp_path / "b", scheduler=cluster.scheduler_address,
+                                    chunk=2).rows())
     assert json.dumps(remote) == json.dumps(local)
     # Interrupted after the first chunk: a restart reuses it (a changed saved row shows it was read).
     chunks = tmp_path / "c" / ".chunks" / sweep_run.digest(str(path), 2)
@@ -148,7 +149,7 @@ def test_dask_cluster_gives_the_local_rows_bit_for_bit_and_a_sweep_resumes(tmp_p
     first = sweep_run.run_chunk(str(path), 0, 2)
     first[0]["reason"] = "from the saved chunk"
     (chunks / "000000.json").write_text(json.dumps(first))
-    resumed = sweep_run.run(str(path), space, tmp_path / "c", jobs=1, chunk=2)
+    resumed = list(sweep_run.run(str(path), space, tmp_path / "c", jobs=1, chunk=2).rows())
     assert resumed[0]["reason"] == "from the saved chunk" and json.dumps(resumed[1:]) == json.dumps(local[1:])
 
 
@@ -172,7 +173,7 @@ def test_unreachable_points_inside_a_valid_grid_are_infeasible_rows(tmp_path):
     """Wires of 0.1 m cannot reach attachments 0.4 m apart from anchors 1.0 m apart: a row, not an error."""
     path = _write(tmp_path, 'rig = "rig.toml"\n[vary]\nanchor_span = [0.4, 1.0]\nwire_length = [0.1]\n'
                             '[measure]\naxes = ["z"]\n')
-    rows = sweep_run.run(str(path), load_space(path), tmp_path / "o", jobs=1)
+    rows = list(sweep_run.run(str(path), load_space(path), tmp_path / "o", jobs=1).rows())
     assert [r["feasible"] for r in rows] == [True, False] and "no taut pose" in rows[1]["reason"]
 
 
@@ -224,7 +225,7 @@ def test_points_are_evaluated_in_file_order_as_given(tmp_path):
     space = load_space(_write(tmp_path, POINTS))
     assert space.size == 2 and space.names == ("a", None)
     assert list(space.points()) == [{"wire_length": 1.0, "attach_span": 0.3}, {"wire_length": 2.5, "attach_span": 0.6}]
-    rows = sweep_run.run(str(tmp_path / "space.toml"), space, tmp_path / "o", jobs=1)
+    rows = sweep_run.run(str(tmp_path / "space.toml"), space, tmp_path / "o", jobs=1).rows()
     for values, row in zip(space.points(), rows):
         rig = configure(space.rig, values)
         assert rig.wires[0].length == values["wire_length"]

@@ -22,13 +22,13 @@ def _chunks(path, chunk):
 def test_a_truncated_chunk_is_named_and_recomputed(tmp_path, capsys):
     path = _write(tmp_path, SPACE)
     space = load_space(path)
-    clean = sweep_run.run(str(path), space, tmp_path / "clean", jobs=1, chunk=2)
+    clean = list(sweep_run.run(str(path), space, tmp_path / "clean", jobs=1, chunk=2).rows())
     folder = _chunks(path, 2)
     folder.mkdir(parents=True)
     whole = json.dumps(sweep_run.run_chunk(str(path), 0, 2))
     (folder / "000000.json").write_text(whole)
     (folder / "000001.json").write_text(whole[: len(whole) // 2])  # a crash before the data reached the disk
-    rows = sweep_run.run(str(path), space, tmp_path / "out", jobs=1, chunk=2)
+    rows = list(sweep_run.run(str(path), space, tmp_path / "out", jobs=1, chunk=2).rows())
     assert json.dumps(rows) == json.dumps(clean)
     err = capsys.readouterr().err
     assert err == f"sweep: {folder / '000001.json'} is unreadable (truncated?): recomputing it\n"

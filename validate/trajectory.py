@@ -11,9 +11,11 @@ import csv
 import errno
 import os
 import tempfile
+from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Mapping
+from typing import IO, Any, Mapping
 
 import numpy as np
 from scipy.spatial.transform import Rotation
@@ -77,16 +79,25 @@ def atomic_write_text(path: str | Path, text: str) -> None:
 
 
 def atomic_write_bytes(path: str | Path, data: bytes) -> None:
-    """Write a whole file or nothing: write a temporary file beside it, then rename. Any failure is an
-    :class:`OSError` naming ``path`` (the user's file), never the temporary one."""
+    """Write a whole file or nothing (see :func:`atomic_file`)."""
+    with atomic_file(path, "wb") as fh:
+        fh.write(data)
+
+
+@contextmanager
+def atomic_file(path: str | Path, mode: str = "w") -> Iterator[IO]:
+    """A file written whole or not at all, in as many pieces as wanted: yields a temporary file beside
+    ``path`` (``mode`` "w": UTF-8 text, newlines as written; "wb": bytes), renamed to ``path`` when the
+    block ends and deleted if it raises. Any failure is an :class:`OSError` naming ``path`` (the user's
+    file), never the temporary one."""
     path = Path(path)
     check_writable(path)
     tmp = None
     try:
         # The temporary name is at most ~70 characters, whatever the length of the final one (<= 255).
         fd, tmp = tempfile.mkstemp(prefix=f".{path.name[:48]}.", suffix=".tmp", dir=path.parent)
-        with os.fdopen(fd, "wb") as fh:
-            fh.write(data)
+        with os.fdopen(fd, mode, **({} if "b" in mode else {"encoding": "utf-8", "newline": ""})) as fh:
+            yield fh
         os.chmod(tmp, 0o666 & ~_umask())  # mkstemp creates 0600; give the file the usual mode
         os.replace(tmp, path)
     except OSError as exc:

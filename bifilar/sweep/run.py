@@ -6,7 +6,9 @@ function of the sweep file and its index range, so any executor gives identical 
 chunk is saved whole (temp + rename) under ``DIR/.chunks/``; a restarted sweep with the same ``--out``
 reuses the saved chunks of the same sweep file (checked by a digest of its contents) and runs the rest;
 a saved chunk that cannot be read back (a crash before its data reached the disk, a full disk) is named
-and recomputed.
+and recomputed. The rows stay in the chunk files: :func:`run` returns :class:`Chunks`, which reads them
+back in grid order a file at a time, so a sweep of 10^7 rows (~20 GB as rows in memory) needs the
+memory of one chunk.
 """
 
 from __future__ import annotations
@@ -19,6 +21,7 @@ import os
 import pickle
 import sys
 import tempfile
+from collections.abc import Iterator
 from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
@@ -120,6 +123,10 @@ def digest(path: str, chunk: int) -> str:
     return h.hexdigest()[:16]
 
 
+def _name(k: int) -> str:
+    return f"{k:06d}.json"
+
+
 def _save(folder: Path, name: str, rows: list[dict]) -> None:
     fd, tmp = tempfile.mkstemp(dir=folder, suffix=".tmp")
     with os.fdopen(fd, "w") as f:
@@ -127,47 +134,60 @@ def _save(folder: Path, name: str, rows: list[dict]) -> None:
     os.replace(tmp, folder / name)
 
 
-def _load(f: Path, size: int) -> list[dict] | None:
-    """The rows saved in chunk file ``f`` (``size`` of them), or None if there is none. A file that is
-    not such a list (truncated or garbled by a killed run or a full disk) is named on stderr and
-    deleted, so that its chunk is recomputed rather than every rerun failing on it."""
+def _intact(f: Path, size: int) -> bool:
+    """Whether chunk file ``f`` holds its ``size`` rows (read, checked, and let go). A file that is not
+    such a list (truncated or garbled by a killed run or a full disk) is named on stderr and deleted,
+    so that its chunk is recomputed rather than every rerun failing on it."""
     if not f.exists():
-        return None
+        return False
     try:
         rows = json.loads(f.read_text())
         if isinstance(rows, list) and len(rows) == size and all(isinstance(r, dict) for r in rows):
-            return rows
+            return True
     except (OSError, ValueError):  # JSONDecodeError and UnicodeDecodeError are ValueErrors
         pass
     print(f"sweep: {f} is unreadable (truncated?): recomputing it", file=sys.stderr, flush=True)
     f.unlink(missing_ok=True)
-    return None
+    return False
+
+
+class Chunks:
+    """The rows of a finished sweep, kept on disk in its chunk files, never in memory: ``size`` rows;
+    :meth:`rows` reads them back one chunk file at a time, in grid order, as often as asked (while
+    the files are there: the sweep command deletes them once its outputs are written)."""
+
+    def __init__(self, folder: Path, ranges: list[tuple[int, int]]):
+        self.folder, self.ranges = folder, ranges
+        self.size = ranges[-1][1] if ranges else 0
+
+    def rows(self) -> Iterator[dict]:
+        for k in range(len(self.ranges)):
+            yield from json.loads((self.folder / _name(k)).read_text())
 
 
 def run(path: str, space: Space, out: Path, jobs: int = 1, scheduler: str | None = None, progress=None,
-        chunk: int | None = None) -> list[dict]:
-    """Every row of the sweep, in grid order, in chunks of ``chunk`` (default :func:`chunk_size`).
-    ``progress(n_done)`` is called as chunks finish."""
+        chunk: int | None = None) -> Chunks:
+    """Run the sweep in chunks of ``chunk`` configurations (default :func:`chunk_size`), each saved as
+    it finishes, and return them as :class:`Chunks` (the rows in grid order, read from the files):
+    memory holds a chunk at a time, whatever the grid's size. ``progress(n_done)`` is called as chunks
+    finish."""
     client = connect(scheduler) if scheduler else None  # before any file is made: a bad address fails at once
     chunk = chunk_size(space.size) if chunk is None else chunk
     chunks = [(s, min(s + chunk, space.size)) for s in range(0, space.size, chunk)]
     folder = out / ".chunks" / digest(path, chunk)
     folder.mkdir(parents=True, exist_ok=True)
-    done: dict[int, list[dict]] = {}
-    for k, (start, stop) in enumerate(chunks):
-        rows = _load(folder / f"{k:06d}.json", stop - start)
-        if rows is not None:
-            done[k] = rows
+    todo = [k for k, (start, stop) in enumerate(chunks) if not _intact(folder / _name(k), stop - start)]
+    finished = space.size - sum(stop - start for start, stop in (chunks[k] for k in todo))
     if progress:
-        progress(sum(len(r) for r in done.values()))
-    todo = [k for k in range(len(chunks)) if k not in done]
+        progress(finished)
     absolute = str(Path(path).resolve())
 
     def finish(k, rows):
-        _save(folder, f"{k:06d}.json", rows)
-        done[k] = rows
+        nonlocal finished
+        _save(folder, _name(k), rows)
+        finished += len(rows)
         if progress:
-            progress(sum(len(r) for r in done.values()))
+            progress(finished)
 
     if client is not None:
         from dask.distributed import as_completed
@@ -175,15 +195,15 @@ def run(path: str, space: Space, out: Path, jobs: int = 1, scheduler: str | None
         with client:
             futures = {client.submit(run_chunk, absolute, *chunks[k], pure=False): k for k in todo}
             for fut in as_completed(futures):
-                finish(futures[fut], fut.result())
+                finish(futures.pop(fut), fut.result())  # popped: a finished future holds its rows
     elif jobs > 1 and len(todo) > 1:
         with ProcessPoolExecutor(max_workers=jobs) as pool:
             futures = {pool.submit(run_chunk, absolute, *chunks[k]): k for k in todo}
             from concurrent.futures import as_completed as done_in_order
 
             for fut in done_in_order(futures):
-                finish(futures[fut], fut.result())
+                finish(futures.pop(fut), fut.result())
     else:
         for k in todo:
             finish(k, run_chunk(absolute, *chunks[k]))
-    return [row for k in range(len(chunks)) for row in done[k]]
+    return Chunks(folder, chunks)

@@ -148,8 +148,8 @@ def boat_hall_sweep(ctx: CaseContext):
     the floor, the motions' extra depth within the clearance margin the sweep keeps at rest."""
     space = load_space(HALL)
     with tempfile.TemporaryDirectory() as tmp:
-        rows = run_sweep(str(HALL), space, Path(tmp), jobs=os.cpu_count() or 1)
-    top = best(rows, space.measure, space.objective)
+        chunks = run_sweep(str(HALL), space, Path(tmp), jobs=os.cpu_count() or 1)
+        top = best(chunks.rows(), space.measure, space.objective)
     if top is None:
         return [check("hall sweep: a feasible configuration exists", 0.0, 1.0, "the hall holds the thesis's own", at_least=True)]
     s = load_suspension(SUSPENSION)

@@ -15,12 +15,16 @@ the objective over the two most varied axes (the best over the others), infeasib
 Pareto front; ``--rerun`` adds ``DIR/sweep.rrd``, the table and the check's motions
 (:mod:`validate.studies.sweep_record`). The evaluation is :mod:`bifilar.sweep`. ``DIR/.lock`` is held
 for the whole run: a second sweep into ``DIR`` meanwhile is refused (exit 2).
+
+The rows are never held: one pass over the chunk files (:class:`bifilar.sweep.run.Chunks`) writes the
+CSV and folds each row into the summary's choice, the figure's cells and sample and the recording's
+columns, so the memory does not grow with the grid (but for ``--rerun``'s ~100 B per row;
+``benchmarks/sweep_memory.py`` measures it).
 """
 
 from __future__ import annotations
 
 import csv
-import io
 import json
 import math
 import sys
@@ -63,17 +67,13 @@ def _cell(x) -> str:
     return repr(float(x)) if isinstance(x, (int, float)) else str(x)
 
 
-def csv_text(axes: list[str], rows: list[dict]) -> str:
-    buf = io.StringIO()
-    w = csv.writer(buf, lineterminator="\n")
-    w.writerow(axes + COLUMNS_AFTER_AXES)
-    for r in rows:
-        w.writerow([_cell(r["values"][a]) for a in axes] + [_cell(p) for p in r["periods"]]
-                   + [_cell(t) for t in r["tensions"]] + [_cell(r["tension_peak"])]
-                   + [_cell(r["sigma"][a]) for a in ("x", "y", "z")] + [_cell(r["clearance"]), _cell(r["feasible"])]
-                   + list(r["motions"]) + [r["dominant"][a] or "" for a in ("x", "y", "z")]
-                   + [_cell(r["separation"]), r["reason"]] + [_cell(r["air_share"][a]) for a in ("x", "y", "z")])
-    return buf.getvalue()
+def csv_row(axes: list[str], r: dict) -> list[str]:
+    """The cells of row ``r`` in ``sweep.csv``: the axes' values, then :data:`COLUMNS_AFTER_AXES`."""
+    return ([_cell(r["values"][a]) for a in axes] + [_cell(p) for p in r["periods"]]
+            + [_cell(t) for t in r["tensions"]] + [_cell(r["tension_peak"])]
+            + [_cell(r["sigma"][a]) for a in ("x", "y", "z")] + [_cell(r["clearance"]), _cell(r["feasible"])]
+            + list(r["motions"]) + [r["dominant"][a] or "" for a in ("x", "y", "z")]
+            + [_cell(r["separation"]), r["reason"]] + [_cell(r["air_share"][a]) for a in ("x", "y", "z")])
 
 
 def _wrap(text: str) -> str:
@@ -83,82 +83,89 @@ def _wrap(text: str) -> str:
     return textwrap.fill(text, width=100, subsequent_indent="  ", break_on_hyphens=False, break_long_words=False)
 
 
-def summary(space, rows: list[dict], seconds: float) -> dict:
-    from bifilar.sweep.choose import best, edges, objective, pareto
+def summary(space, choice, seconds: float) -> dict:
+    """``summary.json``'s entries from the rows' :class:`~bifilar.sweep.choose.Choice`."""
+    from bifilar.sweep.choose import edges, objective
 
     def point(r):
         return {**r["values"], "sigma": {a: r["sigma"][a] for a in space.measure},
                 "objective": objective(r, space.measure, space.objective), "tension_peak": r["tension_peak"]}
 
-    top = best(rows, space.measure, space.objective)
+    top = choice.best[1] if choice.best else None
     return {
-        "n": len(rows),
-        "feasible": sum(r["feasible"] for r in rows),
+        "n": choice.n,
+        "feasible": choice.feasible,
         "objective": f"{space.objective} relative sigma over {list(space.measure)}, feasible rows only",
         "best": point(top) if top else None,
-        "pareto": [point(r) for r in pareto(rows, space.measure, space.objective)],
+        "pareto": [point(r) for r in choice.front.rows],
         "edges": edges(space.axes, top, space.explicit),
         "seconds": seconds,
         "mujoco_check": [],
     }
 
 
-def figure(space, rows: list[dict], path: Path) -> None:
-    """Objective over the two most varied axes (least over the others) and the Pareto front."""
-    import matplotlib
+class Drawing:
+    """What ``sweep.png`` draws, folded in as the rows pass, in memory independent of their number:
+    the least objective per cell of the two most varied axes' grid, and a sample of the feasible rows'
+    (peak tension, objective) (:class:`validate.report.sweep_page.Sample`)."""
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    def __init__(self, space):
+        import numpy as np
+
+        from ..report.sweep_page import Sample
+
+        self.axes = sorted(space.axes, key=lambda a: -len(space.axes[a]))[:2]  # x, y
+        self.values = [space.axes[a] for a in self.axes]
+        self.least = np.full((len(self.values[1]), len(self.values[0])), math.inf) if len(self.axes) == 2 else None
+        self.sample = Sample(space.size)
+
+    def add(self, row: dict, score: float) -> None:
+        import numpy as np
+
+        if self.least is not None:
+            (x, y), (xs, ys) = (row["values"][a] for a in self.axes), self.values
+            at = int(np.argmin(abs(ys - y))), int(np.argmin(abs(xs - x)))
+            self.least[at] = min(self.least[at], score)
+        if math.isfinite(score):
+            self.sample.add((row["tension_peak"], score))
+
+
+def figure(space, drawing: Drawing, data: dict, path: Path) -> None:
+    """Objective over the two most varied axes (least over the others) and, against the peak tension,
+    the feasible rows (a sample of at most :data:`~validate.report.sweep_page.MAX_SCATTER`) and the
+    Pareto front; ``data`` is ``summary.json``'s."""
     import numpy as np
 
-    from bifilar.sweep.choose import best, edges, objective, pareto
+    from ..report.figures import png_bytes, pyplot
+    from ..report.sweep_page import tension_panel
+    from ..trajectory import atomic_write_bytes
 
-    axes = sorted(space.axes, key=lambda a: -len(space.axes[a]))[:2]
+    plt = pyplot()
     fig, (left, right) = plt.subplots(1, 2, figsize=(11, 4.5))
-    if len(axes) == 2:
-        xs, ys = space.axes[axes[0]], space.axes[axes[1]]
-        grid = np.full((len(ys), len(xs)), np.inf)
-        for r in rows:
-            i = int(np.argmin(abs(ys - r["values"][axes[1]])))
-            j = int(np.argmin(abs(xs - r["values"][axes[0]])))
-            grid[i, j] = min(grid[i, j], objective(r, space.measure, space.objective))
+    if drawing.least is not None:
+        axes, (xs, ys), grid, top = drawing.axes, drawing.values, drawing.least, data["best"]
         shown = np.where(np.isfinite(grid), grid, np.nan)
         mesh = left.pcolormesh(xs, ys, 100 * shown, shading="nearest", cmap="viridis")
         fig.colorbar(mesh, ax=left, label=f"{space.objective} sigma (%)")
         bad = ~np.isfinite(grid)
         gx, gy = np.meshgrid(xs, ys)
         left.scatter(gx[bad], gy[bad], marker="x", color="red", s=12, label="infeasible")
-        top = best(rows, space.measure, space.objective)
         if top:
-            left.scatter([top["values"][axes[0]]], [top["values"][axes[1]]], marker="*", s=200, color="white",
+            left.scatter([top[axes[0]]], [top[axes[1]]], marker="*", s=200, color="white",
                          edgecolor="black", label="best")
         hidden = [a for a in space.axes if a not in axes and len(space.axes[a]) > 1]
         left.set_title("least over " + ", ".join(hidden) + " in each cell" if hidden else "every configuration",
                        fontsize=9)
-        for k, edge in enumerate(edges(space.axes, top, space.explicit)):
+        for k, edge in enumerate(data["edges"]):
             left.annotate(f"best on the {edge['side']} edge of {edge['axis']}: widen {edge['widen']}",
                           xy=(0.01, 0.01 + 0.05 * k), xycoords="axes fraction", fontsize=7, color="red")
         left.set_xlabel(f"{axes[0]} (m)")
         left.set_ylabel(f"{axes[1]} (m)")
         left.legend(loc="upper right", fontsize=8)
-    front = pareto(rows, space.measure, space.objective)
-    ok = [r for r in rows if math.isfinite(objective(r, space.measure, space.objective))]
-    right.scatter([r["tension_peak"] for r in ok], [100 * objective(r, space.measure, space.objective) for r in ok],
-                  s=6, color="grey", label="feasible")
-    right.plot([r["tension_peak"] for r in front], [100 * objective(r, space.measure, space.objective) for r in front],
-               "o-", color="tab:orange", label="Pareto front")
-    right.set_xlabel("peak tension (N)")
+    tension_panel(right, drawing.sample, data["pareto"])
     right.set_ylabel(f"{space.objective} sigma (%)")
-    right.set_yscale("log")
-    right.legend(fontsize=8)
-    fig.suptitle(f"sweep of {Path(space.source).name}: {len(rows)} configurations")
-    fig.tight_layout()
-    buf = io.BytesIO()
-    fig.savefig(buf, format="png", dpi=110)
-    plt.close(fig)
-    from ..trajectory import atomic_write_bytes
-
-    atomic_write_bytes(path, buf.getvalue())
+    fig.suptitle(f"sweep of {Path(space.source).name}: {data['n']} configurations")
+    atomic_write_bytes(path, png_bytes(fig, dpi=110))
 
 
 def run(args) -> int:
@@ -188,7 +195,7 @@ def _sweep(args, space, out: Path) -> int:
 
     from bifilar.sweep.run import Unreachable, run as run_sweep
 
-    from ..trajectory import atomic_write_text
+    from ..trajectory import atomic_file, atomic_write_text
 
     jobs = args.jobs or os.cpu_count() or 1
     start = time.perf_counter()
@@ -203,37 +210,35 @@ def _sweep(args, space, out: Path) -> int:
     else:
         progress = None
     try:
-        rows = run_sweep(args.space, space, out, jobs=jobs, scheduler=args.scheduler, progress=progress)
+        chunks = run_sweep(args.space, space, out, jobs=jobs, scheduler=args.scheduler, progress=progress)
     except Unreachable as exc:
         raise UsageError(f"sweep: --scheduler {args.scheduler}: {exc}") from None
     finally:
         if bar is not None:
             bar.close()
     seconds = time.perf_counter() - start
-    data = summary(space, rows, seconds)
-    checked = []
-    if args.check_mujoco:
-        from bifilar.sweep.choose import objective
+    # sweep.csv is renamed into place after the check, as the other outputs are written: all or none
+    with atomic_file(out / "sweep.csv") as fh:
+        choice, drawing, table = _one_pass(space, chunks, fh, args)
+        data = summary(space, choice, seconds)
+        checked = []
+        if args.check_mujoco:
+            from ..studies.sweep_check import check
 
-        from ..studies.sweep_check import check
-
-        ranked = sorted((r for r in rows if math.isfinite(objective(r, space.measure, space.objective))),
-                        key=lambda r: objective(r, space.measure, space.objective))
-        checked = check(space, [r["values"] for r in ranked[: args.check_mujoco]])
-        data["mujoco_check"] = [c.entry for c in checked]
+            checked = check(space, [row["values"] for _, row in choice.ranking.ranked()[: args.check_mujoco]])
+            data["mujoco_check"] = [c.entry for c in checked]
     data["files"] = (["sweep.csv", "summary.json"] + (["sweep.png"] if args.png else []) + ["report.html"]
                      + (["sweep.rrd"] if args.rerun else []))
-    atomic_write_text(out / "sweep.csv", csv_text(list(space.axes), rows))
     atomic_write_text(out / "summary.json", json.dumps(data, indent=1, allow_nan=False) + "\n")
     if args.png:
-        figure(space, rows, out / "sweep.png")
+        figure(space, drawing, data, out / "sweep.png")
     from ..report.sweep_page import write_sweep_html
 
     write_sweep_html(out, space.measure, space.objective, f"sweep of {Path(args.space).name}")
     if args.rerun:
         from ..studies.sweep_record import record_sweep
 
-        record_sweep(out / "sweep.rrd", space, rows, checked)
+        record_sweep(out / "sweep.rrd", space, table, choice.best, checked)
     shutil.rmtree(out / ".chunks", ignore_errors=True)  # the sweep is whole: the resume files are spent
     failed = [c for c in data["mujoco_check"] if not c["ok"]]
     top = data["best"]
@@ -250,3 +255,29 @@ def _sweep(args, space, out: Path) -> int:
         print(f"MuJoCo check of the {len(data['mujoco_check'])} best: largest period difference {worst:.2e}"
               + (f"; {len(failed)} over 1e-6" if failed else " (<= 1e-6)"))
     return 1 if failed else 0
+
+
+def _one_pass(space, chunks, csv_file, args):
+    """One pass over the rows in grid order, none kept: each written to ``csv_file`` (sweep.csv's
+    text) and folded into the choice (count, best, Pareto front, the ``--check-mujoco K`` best), the
+    figure's :class:`Drawing` (with ``--png``) and the recording's columns (with ``--rerun``); returns
+    (choice, drawing or None, columns or None)."""
+    from bifilar.sweep.choose import Choice
+
+    axes = list(space.axes)
+    choice = Choice(space.measure, space.objective, keep=args.check_mujoco)
+    drawing = Drawing(space) if args.png else None
+    table = None
+    if args.rerun:
+        from ..studies.sweep_record import Columns
+
+        table = Columns(space, chunks.size)
+    writer = csv.writer(csv_file, lineterminator="\n")
+    writer.writerow(axes + COLUMNS_AFTER_AXES)
+    for row in chunks.rows():
+        writer.writerow(csv_row(axes, row))
+        score = choice.add(row)
+        for fold in (drawing, table):
+            if fold is not None:
+                fold.add(row, score)
+    return choice, drawing, table

@@ -6,7 +6,8 @@ MuJoCo check.
 Built from ``DIR/summary.json`` and ``DIR/sweep.csv`` (docs/sweep.md), the CSV read row by row twice
 and reduced as it goes, never held whole: the memory is that of the map's cells (at most
 :data:`MAX_CELLS` along each axis, neighbouring values sharing a cell beyond), of a sample of at most
-:data:`MAX_SCATTER` feasible rows (every k-th) and of the best row, whatever the number of rows.
+:data:`MAX_SCATTER` feasible rows (every k-th: :class:`Sample`, which ``sweep.png`` draws too) and of
+the best row, whatever the number of rows.
 """
 
 from __future__ import annotations
@@ -55,6 +56,34 @@ def read_rows(path: Path) -> tuple[list[str], Iterator[dict]]:
     return axes, rows()
 
 
+class Sample:
+    """At most :data:`MAX_SCATTER` of ``n`` points offered one at a time: every ``stride``-th, the
+    stride fixed by ``n``, so the same points whoever draws them (this page and ``sweep.png``)."""
+
+    def __init__(self, n: int):
+        self.stride = max(1, math.ceil(n / MAX_SCATTER))
+        self.points: list[tuple[float, float]] = []
+        self._offered = 0
+
+    def add(self, point: tuple[float, float]) -> None:
+        if self._offered % self.stride == 0:
+            self.points.append(point)
+        self._offered += 1
+
+
+def tension_panel(ax, sample: Sample, pareto: list[dict]) -> None:
+    """The feasible rows' (peak tension, objective) sample, and the Pareto front (``summary.json``'s
+    entries) in full, on a log objective axis (%)."""
+    if sample.points:
+        tension, score = np.array(sample.points, dtype=float).T
+        ax.scatter(tension, 100.0 * score, s=6, color="grey",
+                   label="feasible" + (f" (every {sample.stride}th)" if sample.stride > 1 else ""))
+    ax.plot([p["tension_peak"] for p in pareto], [100.0 * p["objective"] for p in pareto], "o-",
+            color="tab:orange", label="Pareto front")
+    ax.set(xlabel="peak tension (N)", yscale="log")
+    ax.legend(fontsize=8)
+
+
 class _Reduction:
     """The sweep's rows reduced as they pass: the objective's least per map cell, a sample of the
     feasible rows' (peak tension, objective), and the best row's columns."""
@@ -66,8 +95,7 @@ class _Reduction:
         low, high = {a: math.inf for a in axes}, {a: -math.inf for a in axes}
         best = summary.get("best")
         self.best_row = None
-        self.stride = max(1, math.ceil(summary["n"] / MAX_SCATTER))
-        self.scatter, feasible = [], 0
+        self.sample = Sample(summary["n"])
         for row in rows:
             for a, v in row["values"].items():
                 low[a], high[a] = min(low[a], v), max(high[a], v)
@@ -75,9 +103,7 @@ class _Reduction:
                     distinct[a].add(v)
             score = objective(row, self.measure, kind)
             if math.isfinite(score):
-                if feasible % self.stride == 0:
-                    self.scatter.append((_float(row["tension_peak"]), score))
-                feasible += 1
+                self.sample.add((_float(row["tension_peak"]), score))
             if best is not None and self.best_row is None and all(row["values"][a] == best[a] for a in axes):
                 self.best_row = row
         self.shown = sorted(axes, key=lambda a: -len(distinct[a]))[:2]
@@ -123,15 +149,8 @@ class _Reduction:
             left.set(xlabel=f"{self.shown[0]} (m)", ylabel="objective (%)", yscale="log", title="least objective")
         else:
             left.set_axis_off()
-        if self.scatter:
-            tension, score = np.array(self.scatter, dtype=float).T
-            right.scatter(tension, 100.0 * score, s=6, color="grey",
-                          label="feasible" + (f" (every {self.stride}th)" if self.stride > 1 else ""))
-        front = summary.get("pareto") or []
-        right.plot([p["tension_peak"] for p in front], [100.0 * p["objective"] for p in front], "o-",
-                   color="tab:orange", label="Pareto front")
-        right.set(xlabel="peak tension (N)", ylabel="objective (%)", yscale="log", title="objective against peak tension")
-        right.legend(fontsize=8)
+        tension_panel(right, self.sample, summary.get("pareto") or [])
+        right.set(ylabel="objective (%)", title="objective against peak tension")
         return png_bytes(fig)
 
 
