@@ -10,8 +10,8 @@ chunks and writes the outputs) and that of its largest worker (``RUSAGE_CHILDREN
 child it waited for). Printed per N: both peaks (MB), the wall time (s) and the main process's
 bytes per row, its peak above that of a two-chunk sweep (128 configurations, run first) over N.
 
-    python benchmarks/sweep_memory.py              # N = 10^4 and 10^5 (~1.5 min on 2 cores)
-    python benchmarks/sweep_memory.py --large      # and 10^6 (~10 min more)
+    python benchmarks/sweep_memory.py              # N = 10^4 and 10^5 (~3 min on 2 busy cores)
+    python benchmarks/sweep_memory.py --large      # and 10^6 (~20 min more: 1194 s on 2 quiet cores)
     python benchmarks/sweep_memory.py 2000 50000   # these sizes
 """
 
