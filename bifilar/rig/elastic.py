@@ -138,8 +138,10 @@ def _trust_step(g: np.ndarray, h: np.ndarray, radius: float) -> np.ndarray:
 
 
 def rest_pose(rig: Rig, starts, arms: np.ndarray, anchors: np.ndarray, scale: float):
-    """The lowest stable minimum of V from the poses ``starts`` (com, rotation); (com, rotation,
-    tensions) or a :class:`RigError` naming ``wire`` if no start converges to a stable minimum."""
+    """The lowest stable minimum of V with every wire taut from the poses ``starts`` (com, rotation),
+    else the lowest with a wire slack (the caller refuses it); (com, rotation, tensions), or a
+    :class:`RigError` naming ``wire`` if no start converges to a stable minimum. A taut minimum above a
+    slack one is a pose the body can hang in, as the inextensible search's constrained minima are."""
     found = []
     for com, rotation in starts:
         try:
@@ -156,6 +158,8 @@ def rest_pose(rig: Rig, starts, arms: np.ndarray, anchors: np.ndarray, scale: fl
     if not found:
         raise RigError(rig.source, "wire", "no stable rest pose found on the elastic wires (the minimum of the "
                        "potential did not converge from any start)")
+    taut = [f for f in found if f[3].min() > 0.0]
+    found = taut or found
     lowest = min(f[0] for f in found)
     _, c, r, t = next(f for f in found if f[0] <= lowest + 1e-12 * rig.mass * rig.gravity * scale)
     return c, r, t
