@@ -246,3 +246,14 @@ def test_pooling_shares_the_laws_prior():
         fits.append(fit_oscillation(rec.t, rec.y, "angle", ROD_LAW))
     pooled = pool([Trial(None, f, None, f.period, f.period_std, 0.5, ()) for f in fits])
     assert pooled.period_std > 0.9 * min(f.period_std_law for f in fits)
+
+
+def test_a_law_no_rig_has_is_flagged_by_identify():
+    """A record of the bench plate whose periods follow a law 4x the ideal one in A^2 (a rig file whose
+    law is wrong, or a beat read as a chirp): identify says so, names what to check, and says that T0 is
+    known to more than 1 % only (the sigma holds the ideal law's T0 too)."""
+    rec = Y.record(BENCH, np.random.default_rng(3), Y.Traits(amplitude=0.7, cycles=30, excess=3.0, white=0.003))
+    trials, _ = identify_records(PLATE, "z", [Record("log.csv", "angle", "angle", rec.t, rec.y)])
+    flags = " ".join(trials[0].flags)
+    assert trials[0].fit.law.held > 3.0
+    assert "more than a real rig's" in flags and "the rig file" in flags and "known to" in flags

@@ -94,6 +94,14 @@ _ENVELOPE_F = 9.0  # one more term of the envelope must lower chi^2 by this time
 # The real law's excess E = 1 + ds A^2 + dq A^4 + d6 A^6: a stronger cubic restoring term alone already
 # gives all three (over 0.4..1.25 rad, A^2 and A^4 alone leave 2e-4 of it, enough to bias T0 by 1e-4).
 EXCESS_TERMS = ("ds", "dq", "d6")
+# A record whose T(A) asks for an excess this many prior sigmas from the ideal law at some amplitude it
+# swung through follows no rig's law (real ones differ by up to 30-40 %, about one prior sigma): a mode
+# close to the torsion's frequency beating in (its slow phase wobble reads as a chirp), or a rig file
+# whose law is wrong. Either T0, the one learned or the one under the ideal law, may then be the right
+# one: their difference enters T0's sigma (:meth:`_Model.check_law`) and the fit says so (``Law.held``).
+# Learned alone from a gyro record with a mode 3 % from the torsion's, T0 came out 1.4 % off at 5 sigma.
+LAW_CONFLICT = 3.0
+_HELD = 1e-6  # a held excess's prior sd, relative to the prior's own: the data cannot move it
 
 
 @dataclass(frozen=True)
@@ -110,6 +118,8 @@ class Law:
     quartic_std: float
     learned: float
     note: str = ""
+    held: float | None = None  # past LAW_CONFLICT: the excess the record asked for, in prior sigmas
+
 
     @property
     def coefficient(self) -> float | None:
@@ -118,7 +128,7 @@ class Law:
     def as_dict(self) -> dict:
         return {"kind": self.kind, "ideal": self.ideal, "coefficient": self.coefficient, "excess": self.excess,
                 "excess_std": self.excess_std, "excess_quartic": self.quartic, "excess_quartic_std": self.quartic_std,
-                "learned": self.learned, "note": self.note}
+                "learned": self.learned, "note": self.note, "held": self.held}
 
 
 @dataclass(frozen=True)
@@ -238,6 +248,7 @@ def fit_oscillation(t, y, kind: str, law: AmplitudeLaw = LINEAR, *, excess_prior
         baseline = baseline + _baseline(rec.tau, cyc)  # the offsets left under the last baseline
     cyc = _pass(rec, baseline, model.local, second)
     model.fit(cyc, slips=True)
+    model.check_law(cyc)
     whole = _whole(rec, cyc, model, baseline, second)
     return _result(rec, t, cyc, model, baseline, whole, rejected)
 
@@ -544,6 +555,9 @@ class _Model:
         self.omega0 = None
         self.table: Table | None = None
         self.parent: _Model | None = None  # a jackknife refit's: its damping shift and start are the parent's
+        self.held = False  # the excess held at the ideal law (:meth:`check_law`'s fit)
+        self.conflict = 0.0  # the largest excess of the last fit, in prior sigmas
+        self.held_shift = 0.0  # omega0 learned less omega0 under the ideal law (rad/s), past LAW_CONFLICT
 
     def _table(self, omega: float, largest: float) -> Table:
         """The law's table at ``omega`` up to ``largest`` rad, recomputed when omega moves by over 1e-6
@@ -606,7 +620,8 @@ class _Model:
         if law_on and self.prior > 0.0:
             names += list(EXCESS_TERMS)
             start += [0.0] * len(EXCESS_TERMS)
-            priors += [(2 + j, 0.0, self.prior * abs(s)) for j in range(len(EXCESS_TERMS))]
+            hold = _HELD if self.held else 1.0
+            priors += [(2 + j, 0.0, hold * self.prior * abs(s)) for j in range(len(EXCESS_TERMS))]
         if law_on and kappa_max is not None:
             names.append("kappa")
             start.append(0.5 * kappa_max)
@@ -691,6 +706,10 @@ class _Model:
         r_phase, j_phase, j_envelope, rp, jp = evaluate(p)
         a_fit, g_fit, _, _ = terms(p)
         self.names, self.params, self.omega0 = names, p, float(p[1])
+        if "ds" in names and not self.held:  # the excess at each amplitude swung through, in prior sigmas
+            powers = np.array([(a_fit * a_fit) ** (j + 1) for j in range(len(EXCESS_TERMS))])
+            sd = self.prior * abs(s) * np.sqrt(np.sum(powers**2, axis=0))
+            self.conflict = float(np.max(np.abs(p[2:2 + len(EXCESS_TERMS)] @ powers) / np.maximum(sd, 1e-300)))
         self.residual, self.var = r_phase / weights, var
         self.ideal = s if law_on else None
         self.damping = damping
@@ -729,11 +748,22 @@ class _Model:
         self.block = block
         self.cov_white = bread_inv @ (jd.T @ jd) @ bread_inv
         self.cov_stat = (stat_sand if stat_sand[1, 1] > stat_white[1, 1] else stat_white) + envelope
-        self.cov_law = bread_inv @ (jp.T @ jp) @ bread_inv
         # T0's response to the law's prior being off by one sigma in each of its excess terms (their rows
         # come first): records of one rig share that error, while a proportional record's scale is its own
         law_rows = len(EXCESS_TERMS) if "ds" in self.names else 0
+        self.cov_law = bread_inv @ (jp.T @ jp) @ bread_inv
         self.prior_gain = (bread_inv @ jp.T)[1, :law_rows]
+
+    def check_law(self, cyc: _Cycles) -> None:
+        """Past :data:`LAW_CONFLICT`, :attr:`held_shift`: omega0 as fitted less omega0 with the excess held
+        at the ideal law (the same cycles refitted), a doubt T0's sigma carries (:func:`_result`)."""
+        self.held_shift = 0.0
+        if self.conflict <= LAW_CONFLICT:
+            return
+        held = copy.copy(self)  # _solve rebinds its results: the shallow copy keeps this fit's
+        held.held = True
+        held._solve(cyc, cyc.good & np.isfinite(cyc.phase))
+        self.held_shift = self.omega0 - held.omega0
 
     def integral_at(self, tt: np.ndarray) -> np.ndarray:
         """int dt / (R E D) from the reference time to ``tt`` (s), carried on at the end rates beyond the
@@ -1120,8 +1150,11 @@ def _result(rec: _Record, t: np.ndarray, cyc: _Cycles, model: _Model, baseline: 
     to_period = 2.0 * math.pi / omega0**2
     # the whole record's statistical variance, and what the law's parameters add to it; the law's prior
     # part of that is reported apart (and is what records of one rig share)
-    std_law = to_period * math.sqrt(model.cov_law[1, 1])
-    std_all = to_period * math.sqrt(whole.variance + model.law_induced_variance())
+    # a law past LAW_CONFLICT: the record's beat or the rig file's law is wrong, and the interval holds
+    # both T0s (the record's own doubt, not the prior's that the trials share)
+    held = model.held_shift**2
+    std_law = to_period * math.sqrt(model.cov_law[1, 1] + held)
+    std_all = to_period * math.sqrt(whole.variance + model.law_induced_variance() + held)
     std_stat = math.sqrt(max(std_all**2 - std_law**2, to_period**2 * whole.variance))
     jack, groups = model.jackknife(cyc)
     if not (groups and jack > (std_stat / to_period) ** 2 * chi2.ppf(0.95, groups - 1) / (groups - 1)):
@@ -1187,7 +1220,8 @@ def _result(rec: _Record, t: np.ndarray, cyc: _Cycles, model: _Model, baseline: 
                 "(a small swing assumed)")
     law = Law(model.law.kind if model.law.kind != "linear" or model.kind != "proportional" else "none (scale unknown)",
               model.ideal, float(excess), float(std[names.index("ds")]) if "ds" in names else 0.0,
-              float(quartic), float(std[names.index("dq")]) if "dq" in names else 0.0, float(learned), note)
+              float(quartic), float(std[names.index("dq")]) if "dq" in names else 0.0, float(learned), note,
+              model.conflict if model.held_shift else None)
     curve = _law_curve(model, period, cycle_amp)
     level = cyc.offset[good] + np.interp(centre, rec.tau, baseline)  # the offset under each cycle
     amplitude = None

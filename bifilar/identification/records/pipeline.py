@@ -200,11 +200,11 @@ def _flags(record: Record, fit: OscillationFit, halves: Halves | None, options: 
     if halves is not None and abs(halves.z) > HALVES_Z:
         flags.append(f"{name}: its halves disagree by {halves.z:+.2g} sigma (T0 {halves.first[0]:.7g} against "
                      f"{halves.second[0]:.7g} s): its sigma may not hold")
-    if fit.law.ideal and fit.law.learned > 0.5 and options.law_sigma > 0.0:
-        rel = fit.law.excess / fit.law.ideal
-        if abs(rel) > 3.0 * options.law_sigma:
-            flags.append(f"{name}: its periods follow an amplitude law {rel:+.0%} off the ideal rig's (prior "
-                         f"+-{options.law_sigma:.0%}): check the angle unit, the column and the rig file")
+    if fit.law.held is not None:
+        flags.append(f"{name}: its periods ask for an amplitude law {fit.law.held:.2g} prior sigmas (each "
+                     f"+-{options.law_sigma:.0%} of the ideal) off the ideal rig's, more than a real rig's: T0's "
+                     "sigma holds both the T0 learned and the ideal law's (a mode near the torsion's frequency "
+                     "beating in? check the angle unit, the column and the rig file)")
     if fit.period_std > 0.01 * fit.period:
         flags.append(f"{name}: T0 is known to {100.0 * fit.period_std / fit.period:.2g} % only")
     return flags
