@@ -4,8 +4,10 @@ kernels that compile only when they loop.
 The Kane, TMT and signal kernels are compiled by numba with ``cache=True``. Left to itself numba writes
 its cache into ``__pycache__`` beside the sources (which fails silently in a read-only install, and
 litters a checkout); :func:`use_user_cache` points it at the user's cache folder instead, unless
-``NUMBA_CACHE_DIR`` is already set. The first run after an install or a change of a kernel compiles for
-30-80 s; :func:`announce_compile` says so in one line instead of leaving the user in silence.
+``NUMBA_CACHE_DIR`` is already set, and compiles at LLVM's level 2 (:data:`OPT_LEVEL`). The first run
+after an install or a change of a kernel compiles for 30-80 s; :func:`announce_compile` says so in one
+line instead of leaving the user in silence, and the suite runs the cases that compile first, one
+worker each (:data:`validate.registry.COMPILES`).
 
 One-shot work (one rig's rest pose and modes) need not wait for a compiler: :class:`LoopKernels`
 runs a kernel module's functions as plain Python (numpy) until they are either cached on disk or
@@ -27,11 +29,18 @@ def user_cache_dir() -> Path:
     return Path(base) / "bifilar-validate" / "numba"
 
 
+# LLVM's optimisation level for the kernels. numba's default, 3, compiled the suite's kernels in 153 s
+# on 2 busy cores, 2 in 93 s, with the kernels as fast (benchmarks/kane.py, benchmarks/sweep.py side by
+# side: rhs evaluations and sweep configurations per second within their run-to-run scatter).
+OPT_LEVEL = "2"
+
+
 def use_user_cache() -> None:
-    """Set ``NUMBA_CACHE_DIR`` to :func:`user_cache_dir` unless it is set (or numba is already
-    imported, which has read it)."""
-    if "NUMBA_CACHE_DIR" not in os.environ and "numba" not in sys.modules:
-        os.environ["NUMBA_CACHE_DIR"] = str(user_cache_dir())
+    """Set ``NUMBA_CACHE_DIR`` to :func:`user_cache_dir` and ``NUMBA_OPT`` to :data:`OPT_LEVEL`, each
+    unless it is set (or numba is already imported, which has read them)."""
+    if "numba" not in sys.modules:
+        os.environ.setdefault("NUMBA_CACHE_DIR", str(user_cache_dir()))
+        os.environ.setdefault("NUMBA_OPT", OPT_LEVEL)
 
 
 _announced: set[str] = set()
@@ -57,6 +66,11 @@ def announce_modules(what: str, modules, seconds: str) -> None:
     note is printed in this process: for a command that will use them all (``validate all``)."""
     announce_compile(what, *[k for m in modules for k in _dispatchers(m).values()], seconds=seconds)
     _announced.add(EVERYTHING)
+
+
+def all_cached(modules) -> bool:
+    """Whether every kernel of ``modules`` has a cache entry (none will compile at its first call)."""
+    return all(_cached(k) for m in modules for k in _dispatchers(m).values())
 
 
 def _main_process() -> bool:

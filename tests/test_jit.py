@@ -1,6 +1,10 @@
 """bifilar.jit: the plain-Python twin of a kernel module runs the same code as the compiled one (equal
 to rounding), LoopKernels runs one-shot work in Python until it loops (then compiles),
-and a compile note is printed once per process."""
+a compile note is printed once per process, and on an empty cache the suite runs the cases that compile
+first."""
+
+import sys
+import time
 
 import numpy as np
 import pytest
@@ -73,3 +77,39 @@ def test_modes_from_the_twin_match_the_compiled_kernels(name, monkeypatch):
         monkeypatch.setattr(jit, "_cached", lambda kernel, c=cached: c)
         both.append(sorted(m.omega2 for m in linearize(r).modes))
     np.testing.assert_allclose(both[0], both[1], rtol=1e-10)  # eigenvalues of the same matrices to rounding
+
+
+def _logged_case(name, keep, traces):
+    """A stand-in for suite.run_case (inherited by the forked workers): when each case starts and ends."""
+    from validate.suite import CaseResult
+
+    with open(_ORDER_LOG, "a") as out:
+        out.write(f"start {name}\n")
+    time.sleep(0.02)
+    with open(_ORDER_LOG, "a") as out:
+        out.write(f"end {name}\n")
+    return CaseResult(name, "", True, 0.0, [])
+
+
+_ORDER_LOG = ""
+
+
+@pytest.mark.parametrize("cold", [True, False])
+def test_on_an_empty_cache_the_compiling_cases_run_first(cold, monkeypatch, tmp_path):
+    # started together, both workers compiled the same kernels (the first validate all 2.7x a warm one);
+    # on an empty cache the cases tagged COMPILES run first and every other case after the last of them
+    from validate import suite
+    from validate.registry import COMPILES
+
+    monkeypatch.setattr(sys.modules[__name__], "_ORDER_LOG", str(tmp_path / "order"))
+    monkeypatch.setattr(suite, "run_case", _logged_case)
+    monkeypatch.setattr(suite, "_announce_compile", lambda: cold)
+    cases = suite.registered()
+    compiling = {c.name for c in cases if COMPILES in c.tags}
+    assert {"air-torsion-period-shift", "boat-study", "elastic-quadrifilar-closed-form"} <= compiling
+    assert suite.run_cases(cases, jobs=2) == 0
+    lines = [line.split() for line in (tmp_path / "order").read_text().splitlines()]
+    assert sorted(n for what, n in lines if what == "end") == sorted(c.name for c in cases)
+    last_compiling = max(i for i, (what, n) in enumerate(lines) if what == "end" and n in compiling)
+    first_other = min(i for i, (what, n) in enumerate(lines) if what == "start" and n not in compiling)
+    assert (last_compiling < first_other) == cold  # warm: the cases in their order, two at a time

@@ -15,10 +15,11 @@ from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import asdict, dataclass, field
 from typing import Callable, Sequence
 
-from .registry import REGISTRY, Case, CaseContext, Metric
+from .registry import COMPILES, REGISTRY, Case, CaseContext, Metric
 
-# The compile time of every kernel the cases use, empty cache, 2 cores (benchmarks/first_run.py).
-COMPILE_SECONDS = "60-120"
+# The compile time of every kernel the cases use, empty cache, 2 cores (benchmarks/first_run.py: what
+# the first run takes beyond a warm one, 64 s on a quiet machine).
+COMPILE_SECONDS = "45-100"
 
 
 @dataclass
@@ -104,8 +105,9 @@ def run_case(name: str, keep_trajectories: bool = False, keep_traces: bool = Fal
                       c.run.__module__.rsplit(".", 1)[-1], list(ctx.notes), traces)
 
 
-def _announce_compile() -> None:
-    """One note, here in the main process, if the cases' kernels will compile (the workers keep quiet)."""
+def _announce_compile() -> bool:
+    """One note, here in the main process, if the cases' kernels will compile (the workers keep quiet);
+    whether they will."""
     from bifilar import jit, smallmat
     from bifilar.identification import slopes_kernel
     from bifilar.motion import kane_kernel, nwire_kernel
@@ -115,6 +117,7 @@ def _announce_compile() -> None:
 
     modules = (smallmat, kane_kernel, nwire_kernel, tmt, pose_kernel, slopes_kernel, sweep_kernel)
     jit.announce_modules("the Kane, N-wire, TMT and pose kernels", modules, seconds=COMPILE_SECONDS)
+    return not jit.all_cached(modules)
 
 
 def run_cases(cases: list[Case], jobs: int = 2, json_path: str | None = None,
@@ -127,7 +130,7 @@ def run_cases(cases: list[Case], jobs: int = 2, json_path: str | None = None,
     each case is announced on stderr as it finishes, with its verdict and wall time."""
     names = [c.name for c in cases]
     keep = on_result is not None
-    _announce_compile()
+    cold = _announce_compile()
     start = time.perf_counter()
     done: dict[str, CaseResult] = {}
 
@@ -139,9 +142,12 @@ def run_cases(cases: list[Case], jobs: int = 2, json_path: str | None = None,
                   f"({time.perf_counter() - start:.0f} s elapsed)", file=sys.stderr, flush=True)
 
     if jobs > 1 and len(names) > 1:
+        # on an empty cache the cases that compile most kernels run first, one worker each (COMPILES)
+        first = [c.name for c in cases if cold and COMPILES in c.tags]
         with ProcessPoolExecutor(max_workers=jobs) as pool:
-            for future in as_completed([pool.submit(run_case, n, keep, traces) for n in names]):
-                finished(future.result())
+            for batch in (first, [n for n in names if n not in first]):
+                for future in as_completed([pool.submit(run_case, n, keep, traces) for n in batch]):
+                    finished(future.result())
     else:
         for n in names:
             finished(run_case(n, keep, traces))

@@ -133,6 +133,34 @@ def record_coverage(ctx: CaseContext):
     ]
 
 
+@case("identify-record-near-mode", source="issue 18 item 1 (a second mode beating in)", engines=("analytic",),
+      tags=("slow",))
+def record_near_mode(ctx: CaseContext):
+    """24 gyro records of the rod (the identify-record-trials traits: 25 cycles at 250 Hz) with a sway
+    within 10 % of the torsion's frequency, 2-10 % of the swing: within ~5 % it is less than ~1.5
+    beats over the record and the fit cannot find it apart from the first mode. The 95 % intervals
+    should hold the truth in 90-98 % of them, as on any records (measured 83 %, rms z 1.81: the open
+    part of issue 18, docs/identification.md "What is left")."""
+    rng = np.random.default_rng(1821)
+    law = AmplitudeLaw.torsion(ROD)
+    zs = []
+    for _ in range(24):
+        ratio = rng.uniform(0.9, 1.1)
+        traits = Y.gyro(rng, rate=250.0, cycles=25.0)
+        traits = Y.Traits(**{**traits.__dict__, "second": (ratio, rng.uniform(0.02, 0.1), traits.second[2])})
+        rec = Y.record(ROD, rng, traits)
+        fit = fit_oscillation(rec.t, rec.y, "rate", law)
+        zs.append((fit.period - rec.period) / fit.period_std)
+    zs = np.array(zs)
+    low, _ = binom.interval(0.99, len(zs), 0.95)
+    return [
+        check("95 % intervals holding the truth", float(np.sum(np.abs(zs) <= Z95)), low,
+              f"binomial 99 % lower bound of {len(zs)} draws at 95 %", at_least=True),
+        check("rms of (T0 - truth) / sigma", math.sqrt(float(np.mean(zs**2))), 1.0 + 3.0 / math.sqrt(2.0 * len(zs)),
+              f"1 for honest sigmas; the rms of {len(zs)} normal draws errs by 1/sqrt(2 n), 3 of them"),
+    ]
+
+
 def zero_crossing_period(t: np.ndarray, y: np.ndarray, law: AmplitudeLaw, omega: float) -> float:
     """The plain zero-crossing T0 of a rate record with the exact amplitude correction, the estimator
     the issue compares with: the rate's descending crossings of its straight-line trend (a gyro's bias
