@@ -1,5 +1,6 @@
 """The README holds exactly the two set-up commands, and CI runs them as the README prints them, in a
-fresh venv with the newest allowed versions (.ci/run, .ci/readme_commands.py)."""
+fresh venv with the newest allowed versions and an empty numba cache, the tests first (.ci/run,
+.ci/readme_commands.py)."""
 
 import runpy
 import subprocess
@@ -28,7 +29,8 @@ def test_a_readme_without_exactly_two_one_line_blocks_is_refused(text):
 def test_ci_runs_them_in_a_fresh_venv_with_the_newest_versions():
     ci = (ROOT / ".ci" / "run").read_text()
     for step in ("python3 .ci/readme_commands.py", 'python3 -m venv "$work/venv"', 'source "$work/venv/bin/activate"',
-                 "pip install -q --upgrade --upgrade-strategy eager -e '.[test]'", 'bash -euo pipefail -c "$command"',
+                 "pip install -q --upgrade --upgrade-strategy eager -e '.[test]'", 'bash -euo pipefail -c "${commands[i]}"',
+                 'export NUMBA_CACHE_DIR="$work/numba"',
                  "bash .ci/chromium", "bash .ci/wheel"):
         assert step in ci, step
     assert "--system-site-packages" not in ci
