@@ -30,7 +30,7 @@ def user_cache_dir() -> Path:
 
 
 # LLVM's optimisation level for the kernels. numba's default, 3, compiled the suite's kernels in 153 s
-# on 2 busy cores, 2 in 93 s, with the kernels as fast (benchmarks/kane.py, benchmarks/sweep.py side by
+# on 2 busy cores, 2 in 99 s, with the kernels as fast (benchmarks/kane.py, benchmarks/sweep.py side by
 # side: rhs evaluations and sweep configurations per second within their run-to-run scatter).
 OPT_LEVEL = "2"
 
@@ -52,25 +52,34 @@ def announce_compile(what: str, *kernels, seconds: str = "30-80") -> None:
     note would repeat it per worker) if any of ``kernels`` (numba dispatchers with ``cache=True``) has
     no fresh cache entry, i.e. will be compiled at its first call. Call it just before the kernels'
     first use (it reads a small index file per kernel). ``seconds``: the estimate, on 2 cores."""
+    if _first(what) and any(not _cached(k) for k in kernels):
+        _note(what, seconds)
+
+
+def announce_modules(what: str, modules, seconds: str) -> bool:
+    """One note for every kernel of ``modules`` (see :func:`announce_compile`), after which no other
+    note is printed in this process: for a command that will use them all (``validate all``). Whether
+    any of them will compile."""
+    cold = not all(_cached(k) for m in modules for k in _dispatchers(m).values())
+    if _first(what) and cold:
+        _note(what, seconds)
+    _announced.add(EVERYTHING)
+    return cold
+
+
+def _first(what: str) -> bool:
+    """Whether nothing has announced ``what`` (nor everything) in this process yet; marks it."""
     if what in _announced or EVERYTHING in _announced:
-        return
+        return False
     _announced.add(what)
-    if any(not _cached(k) for k in kernels) and _main_process():
+    return True
+
+
+def _note(what: str, seconds: str) -> None:
+    if _main_process():
         where = os.environ.get("NUMBA_CACHE_DIR", "__pycache__ beside the sources")
         print(f"note: compiling {what} with numba (first run after an install or a change, ~{seconds} s; "
               f"cached afterwards in {where})", file=sys.stderr, flush=True)
-
-
-def announce_modules(what: str, modules, seconds: str) -> None:
-    """One note for every kernel of ``modules`` (see :func:`announce_compile`), after which no other
-    note is printed in this process: for a command that will use them all (``validate all``)."""
-    announce_compile(what, *[k for m in modules for k in _dispatchers(m).values()], seconds=seconds)
-    _announced.add(EVERYTHING)
-
-
-def all_cached(modules) -> bool:
-    """Whether every kernel of ``modules`` has a cache entry (none will compile at its first call)."""
-    return all(_cached(k) for m in modules for k in _dispatchers(m).values())
 
 
 def _main_process() -> bool:

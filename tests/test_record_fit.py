@@ -255,5 +255,5 @@ def test_a_law_no_rig_has_is_flagged_by_identify():
     rec = Y.record(BENCH, np.random.default_rng(3), Y.Traits(amplitude=0.7, cycles=30, excess=3.0, white=0.003))
     trials, _ = identify_records(PLATE, "z", [Record("log.csv", "angle", "angle", rec.t, rec.y)])
     flags = " ".join(trials[0].flags)
-    assert trials[0].fit.law.held > 3.0
+    assert trials[0].fit.law.conflict > 3.0
     assert "more than a real rig's" in flags and "the rig file" in flags and "known to" in flags

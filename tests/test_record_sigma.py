@@ -48,7 +48,7 @@ def test_a_law_no_rig_has_is_said_and_its_sigma_holds_both_periods():
     rec = Y.record(ROD, np.random.default_rng(1), Y.Traits(amplitude=0.8, cycles=40.0, excess=3.0, white=0.003,
                                                             zeta=1e-3))
     fit = F.fit_oscillation(rec.t, rec.y, "angle", LAW)
-    assert fit.law.held is not None and fit.law.held > F.LAW_CONFLICT  # measured 9.4
+    assert fit.law.conflict is not None and fit.law.conflict > F.LAW_CONFLICT  # measured 9.4
     assert fit.period_std > 0.01 * fit.period  # measured 11 %: the ideal law's T0 is that far
     assert abs(fit.period - rec.period) < 1.0 * fit.period_std  # the learned T0 is the near one (0.6 %)
 
@@ -58,7 +58,7 @@ def test_a_law_a_real_rig_has_is_learned_not_held():
     rec = Y.record(ROD, np.random.default_rng(1), Y.Traits(amplitude=0.8, cycles=40.0, excess=0.4, white=0.003,
                                                             zeta=1e-3))
     fit = F.fit_oscillation(rec.t, rec.y, "angle", LAW)
-    assert fit.law.held is None and fit.law.learned > 0.5  # mostly the record's (measured 0.90)
+    assert fit.law.conflict is None and fit.law.learned > 0.5  # mostly the record's (measured 0.90)
     assert abs(fit.period - rec.period) < 3.0 * fit.period_std  # 3 sigma: one draw
 
 
@@ -73,5 +73,5 @@ def test_a_mode_beating_near_the_torsion_is_not_read_as_a_law():
                       second=(0.9675, 0.0252, 0.013))
     rec = Y.record(ROD, np.random.default_rng(6), traits)
     fit = F.fit_oscillation(rec.t, rec.y, "rate", LAW)
-    assert fit.law.held is not None
+    assert fit.law.conflict is not None
     assert abs(fit.period - rec.period) < 1.96 * fit.period_std

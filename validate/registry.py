@@ -66,8 +66,9 @@ REGISTRY: dict[str, Case] = {}
 
 # The tag of the cases that, on an empty cache, compile most of the kernels (the Kane kernels; the pose,
 # modes, slopes and sweep kernels; the elastic ones; the TMT ones: 34, 45, 9 and 6 s of the 99 s of
-# compiling, numba's compile events counted per case, 2 busy cores). The suite runs them first, one worker each, and the rest after
-# them (:func:`validate.suite.run_cases`): started together, every worker compiled the same kernels.
+# compiling, numba's compile events counted per case, 2 busy cores). The suite runs them first, one
+# worker each, and the rest after them (:func:`validate.suite.run_cases`): started together, every
+# worker compiled the same kernels.
 COMPILES = "compiles"
 
 

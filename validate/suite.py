@@ -116,8 +116,7 @@ def _announce_compile() -> bool:
     from bifilar.sweep import kernel as sweep_kernel
 
     modules = (smallmat, kane_kernel, nwire_kernel, tmt, pose_kernel, slopes_kernel, sweep_kernel)
-    jit.announce_modules("the Kane, N-wire, TMT and pose kernels", modules, seconds=COMPILE_SECONDS)
-    return not jit.all_cached(modules)
+    return jit.announce_modules("the Kane, N-wire, TMT and pose kernels", modules, seconds=COMPILE_SECONDS)
 
 
 def run_cases(cases: list[Case], jobs: int = 2, json_path: str | None = None,

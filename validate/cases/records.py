@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import math
 import tempfile
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -147,7 +148,7 @@ def record_near_mode(ctx: CaseContext):
     for _ in range(24):
         ratio = rng.uniform(0.9, 1.1)
         traits = Y.gyro(rng, rate=250.0, cycles=25.0)
-        traits = Y.Traits(**{**traits.__dict__, "second": (ratio, rng.uniform(0.02, 0.1), traits.second[2])})
+        traits = replace(traits, second=(ratio, rng.uniform(0.02, 0.1), traits.second[2]))
         rec = Y.record(ROD, rng, traits)
         fit = fit_oscillation(rec.t, rec.y, "rate", law)
         zs.append((fit.period - rec.period) / fit.period_std)

@@ -451,9 +451,10 @@ def _print_trial(i: int, tr: dict) -> None:
     law = tr["law"]
     if law["ideal"] is None:
         _say(f"amplitude law: {law['kind']}" + (f" ({law['note']})" if law["note"] else ""), 4)
-    elif law["held"] is not None:
-        _say(f"amplitude law: {law['kind']}, ideal {law['ideal']:.4g} A^2, held: the record asked for an excess "
-             f"{law['held']:.2g} prior sigmas off it (see the flags)", 4)
+    elif law["conflict"] is not None:
+        _say(f"amplitude law: {law['kind']}, ideal {law['ideal']:.4g} A^2, the record's {law['coefficient']:.4g} "
+             f"A^2, {law['conflict']:.2g} prior sigmas off: no real rig's law, T0's sigma holds the ideal law's "
+             "T0 too (see the flags)", 4)
     elif law["excess_std"] == 0.0:
         _say(f"amplitude law: {law['kind']}, T(A)/T0 - 1 = {law['ideal']:.4g} A^2 + ... (the ideal law, held)", 4)
     else:

@@ -98,7 +98,7 @@ EXCESS_TERMS = ("ds", "dq", "d6")
 # swung through follows no rig's law (real ones differ by up to 30-40 %, about one prior sigma): a mode
 # close to the torsion's frequency beating in (its slow phase wobble reads as a chirp), or a rig file
 # whose law is wrong. Either T0, the one learned or the one under the ideal law, may then be the right
-# one: their difference enters T0's sigma (:meth:`_Model.check_law`) and the fit says so (``Law.held``).
+# one: their difference enters T0's sigma (:meth:`_Model.check_law`) and the fit says so (``Law.conflict``).
 # Learned alone from a gyro record with a mode 3 % from the torsion's, T0 came out 1.4 % off at 5 sigma.
 LAW_CONFLICT = 3.0
 _HELD = 1e-6  # a held excess's prior sd, relative to the prior's own: the data cannot move it
@@ -118,8 +118,7 @@ class Law:
     quartic_std: float
     learned: float
     note: str = ""
-    held: float | None = None  # past LAW_CONFLICT: the excess the record asked for, in prior sigmas
-
+    conflict: float | None = None  # past LAW_CONFLICT: the excess the record asked for, in prior sigmas
 
     @property
     def coefficient(self) -> float | None:
@@ -128,7 +127,7 @@ class Law:
     def as_dict(self) -> dict:
         return {"kind": self.kind, "ideal": self.ideal, "coefficient": self.coefficient, "excess": self.excess,
                 "excess_std": self.excess_std, "excess_quartic": self.quartic, "excess_quartic_std": self.quartic_std,
-                "learned": self.learned, "note": self.note, "held": self.held}
+                "learned": self.learned, "note": self.note, "conflict": self.conflict}
 
 
 @dataclass(frozen=True)
@@ -748,10 +747,10 @@ class _Model:
         self.block = block
         self.cov_white = bread_inv @ (jd.T @ jd) @ bread_inv
         self.cov_stat = (stat_sand if stat_sand[1, 1] > stat_white[1, 1] else stat_white) + envelope
+        self.cov_law = bread_inv @ (jp.T @ jp) @ bread_inv
         # T0's response to the law's prior being off by one sigma in each of its excess terms (their rows
         # come first): records of one rig share that error, while a proportional record's scale is its own
         law_rows = len(EXCESS_TERMS) if "ds" in self.names else 0
-        self.cov_law = bread_inv @ (jp.T @ jp) @ bread_inv
         self.prior_gain = (bread_inv @ jp.T)[1, :law_rows]
 
     def check_law(self, cyc: _Cycles) -> None:
@@ -1221,7 +1220,7 @@ def _result(rec: _Record, t: np.ndarray, cyc: _Cycles, model: _Model, baseline: 
     law = Law(model.law.kind if model.law.kind != "linear" or model.kind != "proportional" else "none (scale unknown)",
               model.ideal, float(excess), float(std[names.index("ds")]) if "ds" in names else 0.0,
               float(quartic), float(std[names.index("dq")]) if "dq" in names else 0.0, float(learned), note,
-              model.conflict if model.held_shift else None)
+              model.conflict if model.conflict > LAW_CONFLICT else None)
     curve = _law_curve(model, period, cycle_amp)
     level = cyc.offset[good] + np.interp(centre, rec.tau, baseline)  # the offset under each cycle
     amplitude = None

@@ -200,8 +200,8 @@ def _flags(record: Record, fit: OscillationFit, halves: Halves | None, options: 
     if halves is not None and abs(halves.z) > HALVES_Z:
         flags.append(f"{name}: its halves disagree by {halves.z:+.2g} sigma (T0 {halves.first[0]:.7g} against "
                      f"{halves.second[0]:.7g} s): its sigma may not hold")
-    if fit.law.held is not None:
-        flags.append(f"{name}: its periods ask for an amplitude law {fit.law.held:.2g} prior sigmas (each "
+    if fit.law.conflict is not None:
+        flags.append(f"{name}: its periods ask for an amplitude law {fit.law.conflict:.2g} prior sigmas (each "
                      f"+-{options.law_sigma:.0%} of the ideal) off the ideal rig's, more than a real rig's: T0's "
                      "sigma holds both the T0 learned and the ideal law's (a mode near the torsion's frequency "
                      "beating in? check the angle unit, the column and the rig file)")
