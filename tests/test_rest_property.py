@@ -119,6 +119,7 @@ def independent_lowest_elastic(data, rng):
 
 @settings(max_examples=20, deadline=None, suppress_health_check=[HealthCheck.filter_too_much])
 @given(seed=st.integers(0, 2**32 - 1), n=st.integers(3, 6))
+@example(seed=101471, n=3)  # a trifilar whose two first starts stopped 17 mm above its lowest taut pose
 def test_rigid_rest_pose_is_the_lowest(seed, n):
     data = build(seed, n, elastic=False)
     if data is None:

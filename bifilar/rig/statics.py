@@ -153,8 +153,8 @@ def _elastic_rest_pose(rig: Rig, guess: Rest | None) -> Rest:
     starts = []
     if len(rig.wires) <= 3:
         # The inextensible pose, a stretch away from the elastic one: two or three wires only, where it is
-        # determinate and cheap (four or more take the multi-start search, which fails on every start of
-        # four parallel wires: measured ~6 s per quadrifilar MuJoCo run; its elastic rest pose is 8 ms).
+        # determinate (three take the multi-start search too; on four parallel wires it fails on every
+        # start: measured ~6 s per quadrifilar MuJoCo run, where its elastic rest pose is 8 ms).
         rigid = replace(rig, wires=tuple(replace(w, axial_stiffness=None) for w in rig.wires))
         try:
             rest = _global_rest_pose(rigid)
@@ -242,9 +242,10 @@ def _global_rest_pose(rig: Rig) -> Rest:
     pose: from a far start SLSQP can settle in a higher, twisted equilibrium (wires crossed) that is
     stable too. Ties keep the file's orientation's.
 
-    Four or more wires have several taut equilibria far apart more often (a 4-wire body has two
-    directions of freedom, a 6-wire one none: its poses are isolated points), and one start stopped in
-    a local minimum or failed (issue 20). They get :data:`MULTI_STARTS` more starts: the hanging
+    Three or more wires can have several taut equilibria far apart (a 3-wire body has three directions
+    of freedom, a 4-wire one two, a 6-wire one none: its poses are isolated points), and one start
+    stopped in a local minimum or failed (issue 20; a random trifilar of the property test sat 17 mm
+    above its lowest pose). They get :data:`MULTI_STARTS` more starts: the hanging
     orientation without the COM's row, and that orientation turned by fixed rotations spread over the
     sphere; a start that fails in any way (no taut pose there, a singular matrix) is skipped, and the
     error of the first start is raised only if no start succeeds."""
@@ -252,7 +253,7 @@ def _global_rest_pose(rig: Rig) -> Rest:
     hanging = _hanging_orientation(rig)
     if Rotation.from_matrix(hanging).magnitude() > _FAR_START:
         starts.append(hanging)
-    if len(rig.wires) >= 4:
+    if len(rig.wires) >= 3:
         starts.append(_hanging_orientation(rig, with_com=False))
         turns = Rotation.random(MULTI_STARTS, random_state=_START_SEED).as_matrix()
         starts += [turn @ hanging for turn in turns]
@@ -278,7 +279,7 @@ def _global_rest_pose(rig: Rig) -> Rest:
     return next(r for r in found if r.com[2] <= lowest + 1e-9 * rig_scale(rig))
 
 
-# Extra rest-pose starts for four or more wires, and the seed of their fixed, reproducible rotations.
+# Extra rest-pose starts for three or more wires, and the seed of their fixed, reproducible rotations.
 MULTI_STARTS = 12
 _START_SEED = 20
 
