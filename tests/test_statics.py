@@ -85,3 +85,17 @@ def test_rest_pose_does_not_depend_on_the_body_frame(turn):
     assert b.com == pytest.approx(a.com, abs=1e-10) and b.tensions == pytest.approx(a.tensions, rel=1e-9)
     periods = [[m.period for m in linearize(r).modes] for r in (tri, turned)]
     assert periods[1] == pytest.approx(periods[0], rel=1e-9)
+
+
+@pytest.mark.parametrize("v", [[0.3, -1.1, 2.0], [1e-8, 0.0, 2e-8], [0.0, 0.0, 3.1]])
+def test_the_rest_search_slopes_are_the_rotation_s_derivatives(v):
+    # d(R(v) r)/dv = -[R(v) r]x J_l(v), the constraint Jacobian SLSQP is given in the rest-pose search:
+    # against central differences of scipy's rotation (step 1e-6: truncation ~1e-12, rounding ~1e-10).
+    from bifilar.rig.statics import _left_jacobian
+
+    v, r, h = np.array(v), np.array([0.2, -0.5, 0.7]), 1e-6
+    numeric = np.column_stack([(Rotation.from_rotvec(v + h * e).apply(r) - Rotation.from_rotvec(v - h * e).apply(r))
+                               / (2.0 * h) for e in np.eye(3)])
+    turned = Rotation.from_rotvec(v).apply(r)
+    skew = np.array([[0.0, -turned[2], turned[1]], [turned[2], 0.0, -turned[0]], [-turned[1], turned[0], 0.0]])
+    np.testing.assert_allclose(-skew @ _left_jacobian(v), numeric, atol=1e-9)

@@ -19,6 +19,7 @@ world frame). Both engines start from :func:`initial_state`, so that they integr
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -313,18 +314,31 @@ def _search(rig: Rig, start: np.ndarray) -> Rest:
     except RigError:  # no taut pose at this orientation: let the minimiser find a feasible one
         com0 = guess
 
-    def potential(x):
-        return x[2] / scale
+    turned = np.einsum("ij,wj->wi", rotation0, arms(rig))  # the arms at rotvec 0 (world frame)
+    ends = anchors(rig)
+    height = np.array([0.0, 0.0, 1.0 / scale, 0.0, 0.0, 0.0])
+
+    def spans(x):
+        """The arms turned by rotvec x[3:6] and the anchor-to-attachment vectors (world, m)."""
+        r = Rotation.from_rotvec(x[3:6]).apply(turned)
+        return r, x[:3] + r - ends
 
     def wire_lengths(x):
-        rot = Rotation.from_rotvec(x[3:6]).as_matrix() @ rotation0
-        return length_errors(rig, x[:3], rot) / scale
+        return (np.linalg.norm(spans(x)[1], axis=1) - lengths(rig)) / scale
+
+    def wire_slopes(x):
+        # d|s_i|/dx: the unit span u_i for the COM, and u_i . d(R r_i)/dv = u_i . (-[R r_i]x J_l(v))
+        # = (R r_i x u_i) . J_l(v) for the rotation vector v (J_l its left Jacobian on SO(3))
+        r, s = spans(x)
+        u = s / np.linalg.norm(s, axis=1)[:, None]
+        return np.hstack([u, np.cross(r, u) @ _left_jacobian(x[3:6])]) / scale
 
     coarse = minimize(
-        potential,
+        lambda x: x[2] / scale,
         np.concatenate([com0, np.zeros(3)]),
+        jac=lambda x: height,
         method="SLSQP",
-        constraints=[{"type": "eq", "fun": wire_lengths}],
+        constraints=[{"type": "eq", "fun": wire_lengths, "jac": wire_slopes}],
         options={"ftol": 1e-12, "maxiter": 500},
     )
     x = coarse.x
@@ -367,6 +381,16 @@ def _search(rig: Rig, start: np.ndarray) -> Rest:
     if not _stable(rig, rest):
         raise RigError(rig.source, "wire", "the only equilibrium with every wire taut found is unstable: no rest pose")
     return rest
+
+
+def _left_jacobian(v: np.ndarray) -> np.ndarray:
+    """J_l(v) = I + (1 - cos t) / t^2 K + (t - sin t) / t^3 K^2 (K = [v]x, t = |v|): exp([v + dv]x) =
+    exp([J_l dv]x) exp([v]x) to first order, so d(R(v) r) / dv = -[R(v) r]x J_l(v)."""
+    t = float(np.linalg.norm(v))
+    k = np.array([[0.0, -v[2], v[1]], [v[2], 0.0, -v[0]], [-v[1], v[0], 0.0]])
+    if t < 1e-6:  # the series: 1/2 - t^2/24 and 1/6 - t^2/120
+        return np.eye(3) + (0.5 - t * t / 24.0) * k + (1.0 / 6.0 - t * t / 120.0) * (k @ k)
+    return np.eye(3) + (1.0 - math.cos(t)) / t**2 * k + (t - math.sin(t)) / t**3 * (k @ k)
 
 
 class Indeterminate(RigError):
