@@ -16,7 +16,8 @@ READER = runpy.run_path(str(ROOT / ".ci" / "readme_commands.py"))
 def test_the_readme_holds_the_two_set_up_commands():
     printed = subprocess.run([sys.executable, str(ROOT / ".ci" / "readme_commands.py")], capture_output=True,
                              text=True, check=True).stdout.splitlines()
-    assert printed == ["pip install -e . && python -m validate all", "pip install -e '.[test]' && python -m pytest"]
+    assert printed == ["pip install -e . && python -m validate all",
+                       "pip install -e '.[test]' && python -m pytest -n auto"]
 
 
 @pytest.mark.parametrize("text", ["# x\n", "## Set up and run\n\n```bash\na\n```\n",
