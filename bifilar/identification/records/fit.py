@@ -31,9 +31,11 @@ own and asks one thing of all of them together, the rig's amplitude law.
    :data:`BLOCK_TAUS` integrated autocorrelation times (tracker noise correlated over many frames, a
    wandering offset, a left-over beat all make neighbouring cycles err together), never below the
    white-noise covariance, plus what the envelope's own uncertainty adds (Murphy-Topel); the prior
-   rows add the law's doubt, reported apart (``period_std_law``). A delete-a-group jackknife of the
-   law's fit over 20 groups of cycles checks it (:meth:`_Model.jackknife`): where its variance is
-   above the covariance's at 95 %, the jackknife's (Student-t scaled) is the statistical variance.
+   rows add the law's doubt, reported apart (``period_std_law``), with the learned law's own doubts
+   (:meth:`_Model.check_law`: its extrapolation to zero swing, a law no rig has). A delete-a-group
+   jackknife of the law's fit over 20 groups of cycles checks it (:meth:`_Model.jackknife`): where its
+   variance is above the covariance's at 95 %, the jackknife's (Student-t scaled) is the statistical
+   variance.
    Tracking noise correlated over a fraction of a cycle moves a cycle's phase, amplitude and waveform
    together; on such video records the covariance alone covered the truth in 77 % of 95 % intervals.
 6. The whole record (:func:`_whole`): every kept sample fitted at once with the law's shape held, for
@@ -555,6 +557,8 @@ class _Model:
         self.table: Table | None = None
         self.parent: _Model | None = None  # a jackknife refit's: its damping shift and start are the parent's
         self.held = False  # the excess held at the ideal law (:meth:`check_law`'s fit)
+        self.terms = len(EXCESS_TERMS)  # the excess terms free: the rest held at zero (:meth:`check_law`)
+        self.order_shift = 0.0  # omega0 learned less omega0 with one excess term fewer (rad/s)
         self.conflict = 0.0  # the largest excess of the last fit, in prior sigmas
         self.held_shift = 0.0  # omega0 learned less omega0 under the ideal law (rad/s), past LAW_CONFLICT
 
@@ -619,8 +623,8 @@ class _Model:
         if law_on and self.prior > 0.0:
             names += list(EXCESS_TERMS)
             start += [0.0] * len(EXCESS_TERMS)
-            hold = _HELD if self.held else 1.0
-            priors += [(2 + j, 0.0, hold * self.prior * abs(s)) for j in range(len(EXCESS_TERMS))]
+            priors += [(2 + j, 0.0, (_HELD if self.held or j >= self.terms else 1.0) * self.prior * abs(s))
+                       for j in range(len(EXCESS_TERMS))]
         if law_on and kappa_max is not None:
             names.append("kappa")
             start.append(0.5 * kappa_max)
@@ -740,7 +744,12 @@ class _Model:
         """Module docstring, step 5: white, block sandwich (at least the white one), the priors', and
         what the envelope's own uncertainty adds (a two-step estimate's correction, Murphy and Topel:
         H^-1 (J^T J_A) V_A (J_A^T J) H^-1, J_A the phases' response to the envelope's coefficients)."""
-        bread_inv = np.linalg.pinv(jd.T @ jd + jp.T @ jp)
+        hessian = jd.T @ jd + jp.T @ jp
+        # equilibrated before the inverse: the columns differ by ~1e3 in scale (phase, omega0 times the
+        # record's span, the excess times A^2), and at a nearly constant swing the direction only the
+        # priors fix has ~1e-10 of the largest curvature, which pinv's cut would otherwise round away
+        scale = 1.0 / np.sqrt(np.maximum(np.diag(hessian), 1e-300))
+        bread_inv = scale[:, None] * np.linalg.pinv(scale[:, None] * hessian * scale[None, :]) * scale[None, :]
         stat_white, stat_sand, block = _white_and_blocks(jd, r, bread_inv)
         cross = jd.T @ j_envelope
         envelope = bread_inv @ cross @ cov_envelope @ cross.T @ bread_inv
@@ -754,12 +763,26 @@ class _Model:
         self.prior_gain = (bread_inv @ jp.T)[1, :law_rows]
 
     def check_law(self, cyc: _Cycles) -> None:
-        """Past :data:`LAW_CONFLICT`, :attr:`held_shift`: omega0 as fitted less omega0 with the excess held
-        at the ideal law (the same cycles refitted), a doubt T0's sigma carries (:func:`_result`)."""
-        self.held_shift = 0.0
+        """Two doubts of the learned law that T0's sigma carries (:func:`_result`: the first where it
+        is more than the sigma already holds), each the same cycles refitted: :attr:`order_shift`, omega0 as fitted less omega0 with the excess's last term held at
+        zero, and past :data:`LAW_CONFLICT` :attr:`held_shift`, omega0 less omega0 with the whole excess
+        held at the ideal law.
+
+        The first is the extrapolation's: a record whose swing spans a narrow range (a lightly damped
+        rig from 1.2 rad to 1.05) gives the law's value, slope and curvature there so precisely that
+        the three terms seem determined, and their extrapolation to zero swing turns a 1e-5 misfit of
+        the law's shape into 1.5e-3 of T0 (6-8 sigma of the covariance's, which only counts the
+        noise); with one term fewer, where the record does determine the law, the two agree to a
+        fraction of their sigma."""
+        self.held_shift = self.order_shift = 0.0
+        if "ds" in self.names and not self.held:
+            fewer = copy.copy(self)  # _solve rebinds its results: the shallow copy keeps this fit's
+            fewer.terms = len(EXCESS_TERMS) - 1
+            fewer._solve(cyc, cyc.good & np.isfinite(cyc.phase))
+            self.order_shift = self.omega0 - fewer.omega0
         if self.conflict <= LAW_CONFLICT:
             return
-        held = copy.copy(self)  # _solve rebinds its results: the shallow copy keeps this fit's
+        held = copy.copy(self)
         held.held = True
         held._solve(cyc, cyc.good & np.isfinite(cyc.phase))
         self.held_shift = self.omega0 - held.omega0
@@ -930,13 +953,17 @@ def _block_length(r: np.ndarray) -> int:
     return int(min(max(1, math.ceil(BLOCK_TAUS * tau_int)) if tau_int > 1.5 else 1, max(1, n // 5)))
 
 
-def _peak_apart(tau: np.ndarray, rest: np.ndarray, w1: float, chirp: float) -> float | None:
+def _peak_apart(tau: np.ndarray, rest: np.ndarray, swept: tuple[float, float]) -> float | None:
     """The angular frequency (rad/s) of a periodogram peak of ``rest`` (what the first mode leaves)
     that stands :data:`SECOND_MODE_POWER` times above the noise floor, within 0.25..4 times the first
-    mode's frequency ``w1`` (at zero swing) and apart from the band it sweeps (``chirp`` below it, and one
-    resolution 2 pi / span) and from that band's third harmonic (what a slightly wrong waveform leaves
-    there; a symmetric oscillator has no even harmonics, and a sway near twice the torsion's frequency
-    is a real rig's); None if none does. The floor is
+    mode's highest frequency and apart from the band it sweeps (``swept``: its lowest and highest
+    frequency over the record, at the largest and the smallest swing; and one resolution 2 pi / span)
+    and from that band's third harmonic (what a slightly wrong waveform leaves there; a symmetric
+    oscillator has no even harmonics, and a sway near twice the torsion's frequency is a real rig's);
+    None if none does. The band is where the first mode was, not below the zero-swing frequency: a
+    record that stays at 1.2 rad swings 9 % below it (the rod's law), and its own third harmonic, left
+    outside a band placed there, passed for a second mode, was subtracted and took 1 % off the swing
+    and 2.2e-3 off T0 (the rod undamped, 1e-4 rad of noise). The floor is
     the periodogram's median over an octave either side where the record is long enough to have one
     (coloured noise included), else white noise's E P = sigma^2 from the differences."""
     rest = rest - np.polyval(np.polyfit(tau, rest, 1), tau)
@@ -944,12 +971,12 @@ def _peak_apart(tau: np.ndarray, rest: np.ndarray, w1: float, chirp: float) -> f
     resolution = 2.0 * math.pi / span
     stride = max(1, -(-len(tau) // _PERIODOGRAM_SAMPLES))
     x, v = tau[::stride], rest[::stride]
-    grid = np.arange(0.25 * w1, min(4.0 * w1, math.pi * (len(x) - 1) / (x[-1] - x[0])), 0.5 * resolution)
+    low, high = swept
+    grid = np.arange(0.25 * high, min(4.0 * high, math.pi * (len(x) - 1) / (x[-1] - x[0])), 0.5 * resolution)
     if len(grid) < 8:
         return None
-    # the first mode sweeps w1 - chirp .. w1 as its swing decays, its third harmonic three times that
-    near = ((grid > w1 - chirp - resolution) & (grid < w1 + resolution)) | (grid < 2.0 * resolution)
-    near |= (grid > 3.0 * (w1 - chirp) - 4.0 * resolution) & (grid < 3.0 * w1 + 4.0 * resolution)
+    near = ((grid > low - resolution) & (grid < high + resolution)) | (grid < 2.0 * resolution)
+    near |= (grid > 3.0 * low - 4.0 * resolution) & (grid < 3.0 * high + 4.0 * resolution)
     power = np.where(near, 0.0, lombscargle(x, v, grid, floating_mean=True))
     j = int(np.argmax(power))
     band = (grid > 0.5 * grid[j]) & (grid < 2.0 * grid[j]) & ~near & (np.abs(grid - grid[j]) > 3.0 * resolution)
@@ -958,6 +985,12 @@ def _peak_apart(tau: np.ndarray, rest: np.ndarray, w1: float, chirp: float) -> f
     else:
         floor = (1.4826 * float(np.median(np.abs(np.diff(v) - np.median(np.diff(v)))))) ** 2 / 2.0
     return float(grid[j]) if power[j] >= SECOND_MODE_POWER * floor and j > 0 else None
+
+
+def _swept(model: _Model, centres: np.ndarray) -> tuple[float, float]:
+    """The lowest and highest frequency (rad/s) the first mode had at the cycles' ``centres`` (s)."""
+    local = model.local_omega(centres)
+    return float(np.min(local)), float(np.max(local))
 
 
 @dataclass(frozen=True)
@@ -973,9 +1006,23 @@ class _Second:
         return np.exp(-self.decay * tau) * (self.c * np.cos(self.omega * tau) + self.s * np.sin(self.omega * tau))
 
 
+def _in_phase_harmonics(cyc: _Cycles, good: np.ndarray) -> dict[int, np.ndarray]:
+    """{n: the n-th odd harmonic's amplitude in each good cycle} (signal units), 1 the fundamental: each
+    window's terms at the time its fundamental peaks (a symmetric oscillator's harmonics are in phase
+    with it there, so the n-th is a_n cos(n Phi)); 0 where a window held fewer harmonics."""
+    out = {}
+    for j, n in enumerate(range(1, _harmonics(math.inf) + 1, 2)):
+        out[n] = np.array([cyc.terms[k][1 + 2 * j] * math.cos(n * cyc.phase[k])
+                           - cyc.terms[k][2 + 2 * j] * math.sin(n * cyc.phase[k])
+                           if len(cyc.terms[k]) > 2 + 2 * j else 0.0 for k in good])
+    return out
+
+
 def _second_mode(rec: _Record, cyc: _Cycles, baseline: np.ndarray, model: _Model) -> _Second | None:
     """Module docstring, step 3: a mode beating in, from the record minus the first mode as the law
-    fitted it (its phase Phi(t), the cycles' fundamentals between them) and the baseline: a
+    fitted it (its phase Phi(t), the cycles' fundamentals and odd harmonics between them: a swing that
+    stays large has a third harmonic of ~1 % whose periodogram sidelobes, a few resolutions off it,
+    stand far above a good record's noise) and the baseline: a
     periodogram peak :data:`SECOND_MODE_POWER` times its median over an octave either side, away from
     the first mode's harmonics, fitted as a damped sinusoid (omega2 and its decay by least squares, its
     two amplitudes linearly). A mode close to the first in frequency is absorbed by the cycles' own
@@ -986,10 +1033,12 @@ def _second_mode(rec: _Record, cyc: _Cycles, baseline: np.ndarray, model: _Model
         return None
     idx = np.concatenate([cyc.index[k] for k in good])
     tau = rec.tau[idx]
-    fundamental = np.interp(tau, cyc.centre[good], cyc.fundamental[good])
-    rest = rec.y[idx] - baseline[idx] - fundamental * np.cos(model.phase_at(tau))
+    phase = model.phase_at(tau)
+    rest = rec.y[idx] - baseline[idx]
+    for n, amplitude in _in_phase_harmonics(cyc, good).items():
+        rest = rest - np.interp(tau, cyc.centre[good], amplitude) * np.cos(n * phase)
     rest = rest - np.polyval(np.polyfit(tau, rest, 1), tau)
-    peak = _peak_apart(tau, rest, model.omega0, float(np.ptp(model.local_omega(cyc.centre[good]))))
+    peak = _peak_apart(tau, rest, _swept(model, cyc.centre[good]))
     if peak is None:
         return None
     span = tau[-1] - tau[0]
@@ -1074,8 +1123,8 @@ def _whole(rec: _Record, cyc: _Cycles, model: _Model, baseline: np.ndarray, seco
         second = None
         fit = _whole_fit(tau, y, u, integral, envelope, level, harmonics, first, None)
     if second is None:
-        chirp = float(np.ptp(model.local_omega(cyc.centre[good])))
-        peak = _peak_apart(tau, fit[2], fit[0][1], chirp)
+        low, high = _swept(model, cyc.centre[good])
+        peak = _peak_apart(tau, fit[2], (low * fit[0][1] / model.omega0, high * fit[0][1] / model.omega0))
         if peak is not None:
             with_second = _whole_fit(tau, y, u, integral, envelope, level, harmonics, list(fit[0][:4]),
                                      _Second(peak, 0.0, 0.0, 0.0))
@@ -1149,11 +1198,17 @@ def _result(rec: _Record, t: np.ndarray, cyc: _Cycles, model: _Model, baseline: 
     to_period = 2.0 * math.pi / omega0**2
     # the whole record's statistical variance, and what the law's parameters add to it; the law's prior
     # part of that is reported apart (and is what records of one rig share)
-    # a law past LAW_CONFLICT: the record's beat or the rig file's law is wrong, and the interval holds
-    # both T0s (the record's own doubt, not the prior's that the trials share)
-    held = model.held_shift**2
+    # the learned law's own doubts (:meth:`_Model.check_law`): its extrapolation to zero swing (one
+    # excess term fewer), and past LAW_CONFLICT the ideal law's T0 (the record's beat or the rig file's
+    # law is wrong); the interval holds both T0s of each (the record's doubt, not the prior's that the
+    # trials share)
+    base = whole.variance + model.law_induced_variance() + model.held_shift**2
+    # the extrapolation's doubt where it is more than the sigma already holds: the sigma is at least the
+    # difference of the two extrapolations (where the record determines the law it is well inside it)
+    order = max(0.0, model.order_shift**2 - base)
+    held = model.held_shift**2 + order
     std_law = to_period * math.sqrt(model.cov_law[1, 1] + held)
-    std_all = to_period * math.sqrt(whole.variance + model.law_induced_variance() + held)
+    std_all = to_period * math.sqrt(base + order)
     std_stat = math.sqrt(max(std_all**2 - std_law**2, to_period**2 * whole.variance))
     jack, groups = model.jackknife(cyc)
     if not (groups and jack > (std_stat / to_period) ** 2 * chi2.ppf(0.95, groups - 1) / (groups - 1)):
