@@ -203,3 +203,17 @@ def test_a_tare_with_unknown_moments_is_taken_as_a_flat_platform(tmp_path, capsy
     report = _json(capsys, ["tensor", path, "--json"])
     assert sum("taken as a flat platform's" in f for f in report["flags"]) == 2
     np.testing.assert_allclose(report["tensor"], OBJECT_INERTIA, rtol=0, atol=1e-5 * 0.0025)
+
+
+def test_a_hanging_s_rig_is_linearised_once():
+    # identify_tensor refits the same hangings' rigs in every draw of a Monte Carlo: the linearisation
+    # is kept per rig object (the same matrices, not recomputed), a new rig object gets its own
+    from bifilar.identification.tensor import _linearised
+    from bifilar.motion.modes import linearize
+
+    disc = rig("trifilar")
+    first = _linearised(disc)
+    assert _linearised(disc) is first
+    np.testing.assert_array_equal(first.stiffness, linearize(disc).stiffness)
+    moved = replace(disc, mass=1.1 * disc.mass)
+    assert _linearised(moved) is not first
