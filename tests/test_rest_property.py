@@ -117,7 +117,9 @@ def independent_lowest_elastic(data, rng):
     return best, slack, energy
 
 
-@settings(max_examples=20, deadline=None, suppress_health_check=[HealthCheck.filter_too_much])
+# derandomize: the same draws on every run, so that CI fails on a change, not on a new draw; a draw
+# that finds a defect becomes an @example or, until fixed, a strict xfail below
+@settings(max_examples=20, deadline=None, suppress_health_check=[HealthCheck.filter_too_much], derandomize=True)
 @given(seed=st.integers(0, 2**32 - 1), n=st.integers(3, 6))
 @example(seed=101471, n=3)  # a trifilar whose two first starts stopped 17 mm above its lowest taut pose
 def test_rigid_rest_pose_is_the_lowest(seed, n):
@@ -144,7 +146,7 @@ def test_rigid_rest_pose_is_the_lowest(seed, n):
     # minimum of the potential: the body can hang there), which rest_pose checked.
 
 
-@settings(max_examples=10, deadline=None)
+@settings(max_examples=10, deadline=None, derandomize=True)
 @given(seed=st.integers(0, 2**32 - 1), n=st.integers(3, 8))
 @example(seed=371995, n=5)  # the two first starts ended slack, a taut minimum lies lower (was refused)
 @example(seed=109851, n=5)  # the lowest minimum is slack, a taut one 0.5 J above it
@@ -168,3 +170,13 @@ def test_elastic_rest_pose_is_the_lowest(seed, n):
         assert ours <= best + 1e-9 * data["body"]["mass"] * 9.81
     # Else the lowest minimum slackens a wire and ours is a higher, stable taut one (as for rigid wires).
     assert ours >= best - 1e-9 * data["body"]["mass"] * 9.81  # never below the lowest: a true minimum
+
+
+@pytest.mark.xfail(strict=True, reason="open defect (issue 20's class): a random six-wire rig whose lowest pose "
+                   "is taut is refused, every start ending with wire 1 slack (found by CI's draw, seed 837)")
+def test_six_wire_rig_837_hangs_at_its_lowest_taut_pose():
+    data = build(837, 6, elastic=False)
+    reference = independent_lowest_rigid(data, np.random.default_rng(838))
+    assert reference is not None and reference[1]  # the lowest pose is taut
+    rest = rest_pose(rig_from_dict(data, source="fuzz.toml"))
+    assert rest.com[2] <= reference[0] + 1e-7
