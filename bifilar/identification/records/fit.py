@@ -764,8 +764,8 @@ class _Model:
 
     def check_law(self, cyc: _Cycles) -> None:
         """Two doubts of the learned law that T0's sigma carries (:func:`_result`: the first where it
-        is more than the sigma already holds), each the same cycles refitted: :attr:`order_shift`, omega0 as fitted less omega0 with the excess's last term held at
-        zero, and past :data:`LAW_CONFLICT` :attr:`held_shift`, omega0 less omega0 with the whole excess
+        is more than the sigma already holds), each the same cycles refitted: :attr:`order_shift`,
+        omega0 as fitted less omega0 with the excess's last term held at zero, and past :data:`LAW_CONFLICT` :attr:`held_shift`, omega0 less omega0 with the whole excess
         held at the ideal law.
 
         The first is the extrapolation's: a record whose swing spans a narrow range (a lightly damped
