@@ -38,10 +38,11 @@ def read_text_file(path: str | Path, max_bytes: int = MAX_FILE_BYTES) -> str:
         fd = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0))
     except OSError as exc:
         raise RigError(src, "file", f"cannot read ({exc.strerror})") from None
+    info = os.fstat(fd)
+    if not stat.S_ISREG(info.st_mode):  # checked before fdopen, which refuses a folder naming the descriptor
+        os.close(fd)
+        raise RigError(src, "file", "is not a regular file (a pipe, device or folder cannot be read as input)")
     with os.fdopen(fd, "rb") as fh:
-        info = os.fstat(fd)
-        if not stat.S_ISREG(info.st_mode):
-            raise RigError(src, "file", "is not a regular file (a pipe, device or folder cannot be read as input)")
         if info.st_size > max_bytes:
             raise RigError(src, "file", f"is {info.st_size} bytes, more than the {max_bytes} an input file may have")
         try:

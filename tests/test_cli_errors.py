@@ -1,0 +1,51 @@
+"""Errors that blamed the wrong thing (issue 35, items 8-14): each is one line on stderr naming the
+file (or option, or stdout), the field and what is wrong, exit status 2, and nothing is written.
+
+Each test runs ``validate.cli.main`` in-process, as ``tests/test_robust.py`` does, unless it needs a
+real process (a full stdout).
+"""
+
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from validate.cli import main
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def run_cli(capsys, *args):
+    code = main([str(a) for a in args])
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+def one_error(err: str) -> str:
+    lines = err.strip().splitlines()
+    assert len(lines) == 1, err
+    assert lines[0].startswith("error: "), err
+    return lines[0]
+
+
+# ------------------------------------------------------------------------- 8: a folder as a rig
+
+
+def test_a_folder_given_as_a_rig_is_not_a_regular_file(tmp_path, capsys):
+    code, out, err = run_cli(capsys, "modes", tmp_path)
+    assert code == 2 and out == ""
+    assert one_error(err) == (f"error: {tmp_path}: file: is not a regular file (a pipe, device or folder cannot be "
+                              "read as input)")
+
+
+@pytest.mark.parametrize("verb, text", [
+    ("tensor", '[[hanging]]\nrig = "."\nperiod = 1.0\n' * 6),
+    ("plan", 'rig = "."\ngenerate = 10\n'),
+])
+def test_a_folder_named_as_rig_inside_a_file_is_not_a_regular_file(tmp_path, capsys, verb, text):
+    path = tmp_path / "in.toml"
+    path.write_text(text)
+    code, out, err = run_cli(capsys, verb, path, *(["--count", "6"] if verb == "plan" else []))
+    assert code == 2 and out == ""
+    assert one_error(err).startswith(f"error: {tmp_path}: file: is not a regular file"), err
