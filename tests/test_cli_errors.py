@@ -49,3 +49,14 @@ def test_a_folder_named_as_rig_inside_a_file_is_not_a_regular_file(tmp_path, cap
     code, out, err = run_cli(capsys, verb, path, *(["--count", "6"] if verb == "plan" else []))
     assert code == 2 and out == ""
     assert one_error(err).startswith(f"error: {tmp_path}: file: is not a regular file"), err
+
+
+# ------------------------------------------------------------- 13: the axial_stiffness axis's unit
+
+
+def test_a_sweep_s_axial_stiffness_below_zero_is_refused_in_its_own_unit(tmp_path, capsys):
+    space = tmp_path / "space.toml"
+    space.write_text(f'rig = "{ROOT / "models/rigs/bench_plate.toml"}"\n[vary]\naxial_stiffness = [-1.0, 1e6]\n')
+    code, out, err = run_cli(capsys, "sweep", space, "--out", tmp_path / "out")
+    assert code == 2 and out == ""
+    assert one_error(err) == f"error: {space}: vary.axial_stiffness: must be above zero (a wire's E A, N); found -1"

@@ -119,8 +119,10 @@ AXES = {
     "platform_radius": platform_radius,
     "axial_stiffness": axial_stiffness,
 }
-# Axes whose values are distances that must be positive.
-POSITIVE = {"wire_length", "wire_length_2", "anchor_span", "attach_span", "platform_radius", "axial_stiffness"}
+# Axes whose values must be above zero -> what a value is, for the message that refuses one.
+POSITIVE = {**dict.fromkeys(("wire_length", "wire_length_2", "anchor_span", "attach_span", "platform_radius"),
+                            "a distance, m"),
+            "axial_stiffness": "a wire's E A, N"}
 
 
 def configure(rig: Rig, values: dict[str, float]) -> Rig:

@@ -123,9 +123,9 @@ def _values(raw, src: str, name: str) -> np.ndarray:
 
 
 def _check_axis(rig: Rig, name: str, values: np.ndarray, src: str, field: str) -> None:
-    """The values' physical range: distances above zero, an inset short of the attachments' midpoint."""
+    """The values' physical range: lengths and stiffnesses above zero, an inset short of the attachments' midpoint."""
     if name in POSITIVE and values.min() <= 0.0:
-        raise RigError(src, field, f"must be above zero (a distance, m); found {values.min():g}")
+        raise RigError(src, field, f"must be above zero ({POSITIVE[name]}); found {values.min():g}")
     if name == "attach_inset":
         half = 0.5 * attach_span_of(rig)
         if values.min() < 0.0 or values.max() >= half:
