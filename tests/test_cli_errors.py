@@ -60,3 +60,28 @@ def test_a_sweep_s_axial_stiffness_below_zero_is_refused_in_its_own_unit(tmp_pat
     code, out, err = run_cli(capsys, "sweep", space, "--out", tmp_path / "out")
     assert code == 2 and out == ""
     assert one_error(err) == f"error: {space}: vary.axial_stiffness: must be above zero (a wire's E A, N); found -1"
+
+
+# ----------------------------------------------------- 12: an output folder that cannot be one
+
+
+@pytest.mark.parametrize("out, reason", [
+    ("afile", "is a regular file, not a folder"),
+    ("afile/sub", "is under {tmp}/afile, which is a regular file, not a folder"),
+    ("afile/sub/deeper", "is under {tmp}/afile, which is a regular file, not a folder"),
+])
+def test_sweep_out_that_cannot_be_a_folder_names_the_path_given(tmp_path, capsys, out, reason):
+    (tmp_path / "afile").write_text("kept\n")
+    code, stdout, err = run_cli(capsys, "sweep", "bench_plate", "--out", tmp_path / out)
+    assert code == 2 and stdout == ""
+    assert one_error(err) == f"error: {tmp_path / out}: cannot write ({reason.format(tmp=tmp_path)})"
+    assert "probe" not in err and (tmp_path / "afile").read_text() == "kept\n"
+
+
+def test_a_file_output_under_a_regular_file_says_so(tmp_path, capsys):
+    (tmp_path / "afile").write_text("kept\n")
+    code, out, err = run_cli(capsys, "case", "no-such-case", "--json", tmp_path / "afile/report.json")
+    assert code == 2
+    assert one_error(err) == (f"error: {tmp_path}/afile/report.json: cannot write (is under {tmp_path}/afile, which "
+                              "is a regular file, not a folder)")
+

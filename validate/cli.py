@@ -267,15 +267,15 @@ def _resolve_inputs(args) -> None:
 
 
 def _check_outputs(args) -> None:
-    """Every output path is checked writable before the work starts (:func:`check_writable`)."""
-    from .trajectory import check_writable
+    """Every output path is checked before the work starts: each file writable, each folder a folder
+    (:mod:`validate.outputs`)."""
+    from .outputs import check_folder, check_writable
 
-    for name in ("out", "json", "rerun", "png", "junit", "html"):
-        value = getattr(args, name, None)
-        if not isinstance(value, str):
-            continue
+    given = {name: value for name in ("out", "json", "rerun", "png", "junit", "html")
+             if isinstance(value := getattr(args, name, None), str)}
+    for name, value in given.items():
         folder = (name == "rerun" and args.command == "all") or (name == "out" and args.command in ("mjcf", "sweep"))
-        check_writable(Path(value) / "probe" if folder else value)
+        (check_folder if folder else check_writable)(value)
 
 
 def _load(path: str):

@@ -35,8 +35,9 @@ from scipy.spatial.transform import Rotation
 from bifilar.bodies.composite import equivalent_box
 
 from .compare import by_rig, columns, compared, cycle_periods, differences
+from .outputs import check_writable
 from .registry import Metric
-from .trajectory import RIG_CHANNELS, Trajectory, check_writable
+from .trajectory import RIG_CHANNELS, Trajectory
 
 if TYPE_CHECKING:
     from .suite import CaseResult

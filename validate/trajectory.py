@@ -8,7 +8,6 @@ own, e.g. ``q`` and ``energy``. Every vector channel is in the world frame (z up
 from __future__ import annotations
 
 import csv
-import errno
 import os
 import tempfile
 from collections.abc import Iterator
@@ -19,6 +18,8 @@ from typing import IO, Any, Mapping
 
 import numpy as np
 from scipy.spatial.transform import Rotation
+
+from .outputs import check_writable
 
 # name -> (columns in the CSV, meaning); the per-wire channels have one column per wire, numbered
 # from 1 like the [[wire]] tables (tension_1..tension_N, length_error_1..length_error_N).
@@ -108,23 +109,6 @@ def atomic_file(path: str | Path, mode: str = "w") -> Iterator[IO]:
         if tmp is not None:
             Path(tmp).unlink(missing_ok=True)
         raise
-
-
-def check_writable(path: str | Path) -> None:
-    """Raise :class:`OSError` (naming ``path``) unless a file can be written at ``path``: not a folder,
-    its folder exists or can be made, and is writable. Commands call this before their work, so that
-    a bad output path fails at once, not after the run."""
-    path = Path(path)
-    if path.is_dir():
-        raise IsADirectoryError(errno.EISDIR, "is a directory", str(path))
-    try:
-        path.parent.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise OSError(exc.errno, exc.strerror or str(exc), str(path)) from None
-    if not os.access(path.parent, os.W_OK | os.X_OK):
-        raise PermissionError(errno.EACCES, "Permission denied", str(path))
-    if len(path.name.encode()) > 255:
-        raise OSError(errno.ENAMETOOLONG, "File name too long", str(path))
 
 
 class NonFiniteTrajectory(ValueError):

@@ -172,7 +172,7 @@ def run(args) -> int:
     from bifilar.sweep.run import InUse, lock
     from bifilar.sweep.space import load_space
 
-    from ..trajectory import check_writable
+    from ..outputs import check_writable
 
     out = Path(args.out)
     if args.scheduler is not None and not args.scheduler.strip():  # not a quiet fall-back to local processes
