@@ -85,3 +85,20 @@ def test_a_file_output_under_a_regular_file_says_so(tmp_path, capsys):
     assert one_error(err) == (f"error: {tmp_path}/afile/report.json: cannot write (is under {tmp_path}/afile, which "
                               "is a regular file, not a folder)")
 
+
+# ------------------------------------------------------------- 14: one path for two outputs
+
+
+@pytest.mark.parametrize("argv, first, second", [
+    (["all", "-k", "no-such-case", "--json", "{p}", "--junit", "{p}"], "json", "junit"),
+    (["case", "no-such-case", "--html", "{p}", "--junit", "./{p}"], "junit", "html"),
+    (["simulate", "plate", "--duration", "0.1", "--out", "{p}", "--rerun", "{p}"], "out", "rerun"),
+])
+def test_one_path_for_two_outputs_is_refused_before_anything_is_written(tmp_path, capsys, monkeypatch, argv,
+                                                                         first, second):
+    monkeypatch.chdir(tmp_path)
+    code, out, err = run_cli(capsys, *[a.format(p="report.out") for a in argv])
+    assert code == 2 and out == ""
+    line = one_error(err)
+    assert line.startswith(f"error: --{second}: ") and f"is also the --{first} output" in line, line
+    assert not (tmp_path / "report.out").exists()

@@ -267,12 +267,17 @@ def _resolve_inputs(args) -> None:
 
 
 def _check_outputs(args) -> None:
-    """Every output path is checked before the work starts: each file writable, each folder a folder
-    (:mod:`validate.outputs`)."""
-    from .outputs import check_folder, check_writable
+    """Every output path is checked before the work starts: no two options name the same path (one
+    would overwrite the other), each file writable, each folder a folder (:mod:`validate.outputs`)."""
+    from .outputs import check_folder, check_writable, distinct_outputs
 
     given = {name: value for name in ("out", "json", "rerun", "png", "junit", "html")
              if isinstance(value := getattr(args, name, None), str)}
+    clash = distinct_outputs(given)
+    if clash:
+        first, second = clash
+        raise UsageError(f"--{second}: {given[second]} is also the --{first} output: one would overwrite the other; "
+                         "give each output its own path (nothing written)")
     for name, value in given.items():
         folder = (name == "rerun" and args.command == "all") or (name == "out" and args.command in ("mjcf", "sweep"))
         (check_folder if folder else check_writable)(value)

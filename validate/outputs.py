@@ -32,6 +32,18 @@ def check_folder(path: str | Path) -> None:
     _make_folder(Path(path), Path(path))
 
 
+def distinct_outputs(outputs: dict[str, str]) -> tuple[str, str] | None:
+    """The first two options (names as keys, paths as values) that name the same path, else None: one
+    output would overwrite the other, and the first written would be lost."""
+    seen: dict[str, str] = {}
+    for name, value in outputs.items():
+        key = os.path.realpath(value)
+        if key in seen:
+            return seen[key], name
+        seen[key] = name
+    return None
+
+
 def _make_folder(folder: Path, named: Path) -> None:
     """Make ``folder`` (and its parents), refusing, as ``named``, an existing ancestor that is not a
     folder, a folder that cannot be made, or one that cannot be written."""
