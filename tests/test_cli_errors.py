@@ -102,3 +102,24 @@ def test_one_path_for_two_outputs_is_refused_before_anything_is_written(tmp_path
     line = one_error(err)
     assert line.startswith(f"error: --{second}: ") and f"is also the --{first} output" in line, line
     assert not (tmp_path / "report.out").exists()
+
+
+# ------------------------------------------------------------- 11: a tare in some hangings only
+
+
+@pytest.mark.parametrize("bare", [4, 1])
+def test_a_tare_in_some_hangings_only_names_the_hanging_without_one(tmp_path, capsys, bare):
+    import re
+
+    from validate.cases.tensor import write_tare_hangings
+
+    path = Path(write_tare_hangings(tmp_path, [2.0] * 7, 2.0, 1e-6, 1e-6))  # refused before any period is used
+    tables = path.read_text().split("[[hanging]]")
+    tables[bare] = re.sub(r"tare = .*\n", "", tables[bare])
+    path.write_text("[[hanging]]".join(tables))
+    code, out, err = run_cli(capsys, "tensor", path)
+    assert code == 2 and out == ""
+    other = 2 if bare == 1 else 1
+    assert one_error(err) == (f"error: {path}: hanging[{bare}].tare: missing in hanging[{bare}], given in "
+                              f"hanging[{other}]: give a tare in every hanging or in none (with one, each rig's body "
+                              "is the whole assembly)")

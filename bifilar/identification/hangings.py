@@ -102,6 +102,7 @@ def read_hangings(path: str | Path) -> Setup:
         raise RigError(src, "hanging", f"{len(raw)} hangings cannot determine the 6 tensor components: give at "
                                        "least 6 orientations")
     entries = [_entry(h, i, src, folder) for i, h in enumerate(raw, start=1)]
+    _tare_in_all_or_none(entries, src)
     fixtures: dict[tuple, Fixture] = {}
     for e in entries:
         if e.tare is not None and e.tare.key not in fixtures:
@@ -349,6 +350,17 @@ def _measure_period(rig: Rig, axis, period, period_std, signals, options, amplit
     return Measured(period, std, f"given, sigma: {source}")
 
 
+def _tare_in_all_or_none(entries: list[_Entry], src: str) -> None:
+    """Refuse a tare in some hangings only, naming the first hanging without one: the rigs' bodies are
+    read differently with a tare (the whole assembly's) than without (the object's), so a mix would
+    be blamed on a body's mass or COM, far from the cause."""
+    tared = [e.tare is not None for e in entries]
+    if any(tared) and not all(tared):
+        i, k = tared.index(False), tared.index(True)
+        raise RigError(src, f"hanging[{i + 1}].tare", f"missing in {entries[i].label}, given in {entries[k].label}: "
+                       "give a tare in every hanging or in none (with one, each rig's body is the whole assembly)")
+
+
 def _object_body(entries: list[_Entry], fixtures: dict, src: str) -> tuple[float, np.ndarray | None]:
     """The object's mass (kg) and, without tares, its COM (object axes); refused if they differ."""
     masses, coms = [], []
@@ -368,10 +380,7 @@ def _object_body(entries: list[_Entry], fixtures: dict, src: str) -> tuple[float
             what = "object's mass (assembly minus tare)" if e.tare else "body.mass"
             raise RigError(str(e.rig_path), "body.mass", f"the {what} {m:.6g} kg differs from {entries[0].label}'s "
                            f"{masses[0]:.6g} kg by more than {_SAME_MASS:.1%}: not the same object")
-    if any(c is None for c in coms):
-        if not all(c is None for c in coms):
-            raise RigError(src, "hanging", "give a tare in every hanging or in none: the object's COM and the rigs' "
-                                           "bodies are read differently with one")
+    if any(c is None for c in coms):  # every hanging has a tare (_tare_in_all_or_none)
         return masses[0], None
     size = min(rig_size(_rig(e.data, str(e.rig_path)).wires) for e in entries)
     for e, c in zip(entries, coms):
