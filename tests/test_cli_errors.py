@@ -123,3 +123,35 @@ def test_a_tare_in_some_hangings_only_names_the_hanging_without_one(tmp_path, ca
     assert one_error(err) == (f"error: {path}: hanging[{bare}].tare: missing in hanging[{bare}], given in "
                               f"hanging[{other}]: give a tare in every hanging or in none (with one, each rig's body "
                               "is the whole assembly)")
+
+
+# ------------------------------------------------------------------------- 9: a full stdout
+
+
+@pytest.mark.skipif(not Path("/dev/full").exists(), reason="needs /dev/full")
+def test_a_full_stdout_is_named_not_the_rig():
+    with open("/dev/full", "w") as full:
+        proc = subprocess.run([sys.executable, "-m", "validate", "modes", "plate", "--json"], stdout=full,
+                              stderr=subprocess.PIPE, text=True, cwd=ROOT, timeout=60)
+    assert proc.returncode == 2
+    assert one_error(proc.stderr) == "error: stdout: cannot write (No space left on device)"
+
+
+class _FullStream:
+    """A stdout whose every write fails as a full device's does (a report larger than the buffer)."""
+
+    def write(self, text):
+        raise OSError(28, "No space left on device")
+
+    def flush(self):
+        pass
+
+    def fileno(self):
+        raise OSError(9, "no descriptor")
+
+
+def test_a_write_that_fails_inside_a_command_is_stdout_s(capsys, monkeypatch):
+    monkeypatch.setattr(sys, "stdout", _FullStream())
+    code = main(["list", "--rigs"])
+    assert code == 2
+    assert one_error(capsys.readouterr().err) == "error: stdout: cannot write (No space left on device)"

@@ -27,6 +27,8 @@ from .commands import plan as plan_cli
 from .commands import sweep as sweep_cli
 from .commands import tensor as tensor_cli
 from .statuses import BAD_INPUT, BROKEN_PIPE, INTERRUPTED, OK, RUN_FAILED, WENT_SLACK, epilog
+from .stdout import StdoutFailed
+from .stdout import guarded as guarded_stdout
 
 EPILOG = epilog(examples=(
     "python -m validate modes models/rigs/plate.toml",
@@ -135,12 +137,13 @@ def main(argv: list[str] | None = None) -> int:
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         try:
-            args = build_parser().parse_args(argv)
-            args.argv = list(sys.argv[1:] if argv is None else argv)  # the command line, for the reports
-            _resolve_inputs(args)
-            _check_outputs(args)
-            code = _COMMANDS[args.command](args)
-            sys.stdout.flush()
+            with guarded_stdout():
+                args = build_parser().parse_args(argv)
+                args.argv = list(sys.argv[1:] if argv is None else argv)  # the command line, for the reports
+                _resolve_inputs(args)
+                _check_outputs(args)
+                code = _COMMANDS[args.command](args)
+                sys.stdout.flush()
         except BaseException as exc:  # every way out becomes one line and an exit status
             return _failure(exc, args)
     _print_warnings(caught)
@@ -154,6 +157,10 @@ def _failure(exc: BaseException, args) -> int:
     if isinstance(exc, BrokenPipeError) or (isinstance(exc, OSError) and exc.errno == 32 and exc.filename is None):
         _silence_stdout()
         return BROKEN_PIPE
+    if isinstance(exc, StdoutFailed):  # an output that cannot be written, as a file's below
+        _silence_stdout()
+        _error(f"stdout: cannot write ({exc})")
+        return BAD_INPUT
     if isinstance(exc, KeyboardInterrupt) or _caused_by_interrupt(exc):
         _error("interrupted")
         return INTERRUPTED

@@ -11,7 +11,8 @@ OK, CHECK_FAILED, BAD_INPUT, WENT_SLACK, RUN_FAILED, INTERRUPTED, BROKEN_PIPE = 
 MEANING = {
     OK: "success",
     CHECK_FAILED: "a validation check failed",
-    BAD_INPUT: "bad input: one line on stderr naming the file (or option), the field and the problem",
+    BAD_INPUT: "bad input: one line on stderr naming the file (or option), the field and the problem; or an "
+               "output that cannot be written (a file, a folder, stdout): one line naming it and the reason",
     WENT_SLACK: "a wire went slack and the taut-wire Kane model stopped there (the CSV ends there)",
     RUN_FAILED: "a run that failed: a numerical failure inside the physics or a spent work budget (one line "
                 "naming the field most likely responsible)",
