@@ -155,3 +155,39 @@ def test_a_write_that_fails_inside_a_command_is_stdout_s(capsys, monkeypatch):
     code = main(["list", "--rigs"])
     assert code == 2
     assert one_error(capsys.readouterr().err) == "error: stdout: cannot write (No space left on device)"
+
+
+# -------------------------------------------------- 10: absurd values in hangings and candidates
+
+
+HANGING = f'[[hanging]]\nrig = "{ROOT / "models/rigs/trifilar.toml"}"\norientation = [0.0, 0.0, 0.0]\nperiod = 2.0\n'
+
+
+@pytest.mark.parametrize("old, new, field, words", [
+    ("orientation = [0.0, 0.0, 0.0]", "orientation = [1e300, 0, 0]", "orientation", "at most a turn"),
+    ("orientation = [0.0, 0.0, 0.0]", "orientation = [0.0, 0.0, 90.0]", "orientation", "is it in degrees?"),
+    ("period = 2.0", "period = 1e300", "period", "1e+300 s is outside 0.001 .. 100000 s"),
+    ("period = 2.0", "period = 1e-300", "period", "1e-300 s is outside"),
+    ("period = 2.0", "period = 2.0\nperiod_std = 1e300", "period_std", "1e+300 s is outside 0 .. 100 s"),
+    ("period = 2.0", "period = 2.0\nperiod_std = 50.0", "period_std", "more than 0.5 of the period 2 s"),
+    ("period = 2.0", 'period = 2.0\ntare = { rig = "t.toml", period = 1e300 }', "tare.period", "outside"),
+])
+def test_absurd_values_in_a_hangings_file_name_the_file_and_field(tmp_path, capsys, old, new, field, words):
+    path = tmp_path / "hangings.toml"
+    path.write_text(HANGING.replace(old, new) + "\n" + HANGING * 6)
+    code, out, err = run_cli(capsys, "tensor", path)
+    assert code == 2 and out == ""
+    line = one_error(err)
+    assert line.startswith(f"error: {path}: hanging[1].{field}: ") and words in line, line
+
+
+@pytest.mark.parametrize("text, field", [
+    ("generate = 10\nperiod_std = 1e300\n", "period_std"),
+    ("period_std = 1e-4\n[[candidate]]\norientation = [1e300, 0, 0]\n", "candidate[1].orientation"),
+])
+def test_absurd_values_in_a_candidates_file_name_the_file_and_field(tmp_path, capsys, text, field):
+    path = tmp_path / "candidates.toml"
+    path.write_text(f'rig = "{ROOT / "models/rigs/trifilar.toml"}"\n' + text)
+    code, out, err = run_cli(capsys, "plan", path, "--count", "6")
+    assert code == 2 and out == ""
+    assert one_error(err).startswith(f"error: {path}: {field}: "), err

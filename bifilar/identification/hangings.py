@@ -31,9 +31,9 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from bifilar.rig import Rig, RigError
-from bifilar.rig.checks import no_unknown, number, positive, read_toml, required, vector3
+from bifilar.rig.checks import no_unknown, number, positive, read_toml, required, vector3, within
 from bifilar.rig.file import rig_from_dict
-from bifilar.rig.ranges import rig_size
+from bifilar.rig.ranges import MAX_PERIOD_SIGMA, MAX_RELATIVE_SIGMA, rig_size
 from bifilar.rig.statics import rest_pose
 
 from .identify import amplitude_ratio, invert_period
@@ -50,6 +50,8 @@ _GUESSES = (0.5, 0.2, 1.0, 0.05, 2.0)  # x m r^2: a first pass's isotropic guess
 _ROTATION_TOL = 1e-6  # |Q^T Q - 1| and |det Q - 1| of a given matrix
 _SAME_MASS = 1e-3  # relative: objects whose masses differ by more are not the same object
 _SAME_COM = 1e-3  # x rig size: the same for the COM
+PERIOD_RANGE = (1e-3, 1e5)  # s: a measured period, from a millisecond to a day; beyond, a unit or typing mistake
+MAX_TURN = 2.0 * math.pi  # rad: the norm of an orientation's rotation vector; more is a unit mistake (degrees?)
 
 
 @dataclass(frozen=True)
@@ -200,12 +202,15 @@ def _source(t: dict, src: str, prefix: str, folder: Path):
     if has_period == has_signal:
         raise RigError(src, prefix + "period", "give either period (s) or signal (records), not "
                        + ("both" if has_period else "neither"))
-    period = positive(t["period"], src, prefix + "period") if has_period else None
+    period = None
+    if has_period:
+        period = within(positive(t["period"], src, prefix + "period"), *PERIOD_RANGE, src, prefix + "period", "s",
+                        "a measured period, from a millisecond to a day")
     period_std = None
     if "period_std" in t:
         if not has_period:
             raise RigError(src, prefix + "period_std", "goes with period; a record's sigma is fitted")
-        period_std = positive(t["period_std"], src, prefix + "period_std")
+        period_std = period_sigma(t["period_std"], src, prefix + "period_std", period)
     signals: tuple[Path, ...] = ()
     if has_signal:
         value = t["signal"]
@@ -255,6 +260,16 @@ def _amplitude(h: dict, src: str, prefix: str, period) -> float:
     return value
 
 
+def period_sigma(value, src: str, name: str, period: float | None = None) -> float:
+    """A period's sigma (s): positive, at most the rig file's bound for ``[uncertainty].period`` and, with
+    the ``period`` it goes with, at most the share of it a rig file allows for any sigma."""
+    sigma = within(positive(value, src, name), 0.0, MAX_PERIOD_SIGMA, src, name, "s", "a period's sigma")
+    if period is not None and sigma > MAX_RELATIVE_SIGMA * period:
+        raise RigError(src, name, f"{sigma:.6g} s is more than {MAX_RELATIVE_SIGMA:g} of the period {period:.6g} s: "
+                                  "not a measurement's sigma")
+    return sigma
+
+
 def orientation(value, src: str, name: str) -> np.ndarray:
     """Q (object axes -> rig body axes) from a rotation vector (rad) or a 3x3 rotation matrix."""
     if value is None:
@@ -265,7 +280,10 @@ def orientation(value, src: str, name: str) -> np.ndarray:
         if np.abs(q.T @ q - np.eye(3)).max() > _ROTATION_TOL or abs(np.linalg.det(q) - 1.0) > _ROTATION_TOL:
             raise RigError(src, name, f"is not a rotation matrix (Q^T Q = 1 and det Q = +1 to {_ROTATION_TOL:g})")
         return q
-    return Rotation.from_rotvec(vector3(value, src, name)).as_matrix()
+    vector = vector3(value, src, name)
+    within(math.hypot(*vector), 0.0, MAX_TURN, src, name, "rad",
+           "the norm of a rotation vector, at most a turn: is it in degrees?")
+    return Rotation.from_rotvec(vector).as_matrix()
 
 
 def _bad_matrix(src: str, name: str):

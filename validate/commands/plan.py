@@ -79,10 +79,10 @@ def run(args) -> int:
 
 def read_candidates(path: str):
     """(rig, fixture or None, period sigma (s), [(name, Q)]) of a candidates file."""
-    from bifilar.identification.hangings import orientation
+    from bifilar.identification.hangings import orientation, period_sigma
     from bifilar.identification.plan import hemisphere
     from bifilar.rig import RigError, load_rig
-    from bifilar.rig.checks import no_unknown, positive, read_toml, required
+    from bifilar.rig.checks import no_unknown, read_toml, required
 
     data = read_toml(path)
     folder = Path(path).parent
@@ -96,7 +96,7 @@ def read_candidates(path: str):
         if not isinstance(data["fixture"], str):
             raise RigError(path, "fixture", "must be a file name (relative to the candidates file)")
         fixture = load_rig(folder / data["fixture"])
-    sigma = positive(data["period_std"], path, "period_std") if "period_std" in data else rig.uncertainty.period
+    sigma = period_sigma(data["period_std"], path, "period_std") if "period_std" in data else rig.uncertainty.period
     if sigma <= 0.0:
         raise RigError(path, "period_std", f"missing, and {rig.source} states no [uncertainty].period: give the "
                                            "periods' sigma (s)")
