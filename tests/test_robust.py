@@ -11,6 +11,7 @@ import subprocess
 import sys
 import time
 from pathlib import Path
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
@@ -368,25 +369,24 @@ def test_numba_cache_is_outside_the_source_tree_and_a_first_compile_is_announced
     assert proc.stdout.strip() == str(tmp_path / "bifilar-validate" / "numba")
     from bifilar import jit
     from bifilar.jit import announce_compile
-    from bifilar.motion import kane_kernel as K
 
     monkeypatch.setattr(jit, "_announced", set())  # as in a new process (an earlier test may have announced all)
 
-    class Fresh:  # a kernel without a cache entry, as numba sees a first run
-        class _cache:
-            class _cache_file:
-                @staticmethod
-                def _load_index():
-                    return {}
+    def kernel(index):  # a numba dispatcher as announce_compile sees it: its cache's index of entries
+        return SimpleNamespace(_cache=SimpleNamespace(_cache_file=SimpleNamespace(_load_index=lambda: index)))
+
+    # Fresh: no cache entry, as numba sees a first run; Cached: an entry (not K.rhs itself, whose cache
+    # is empty on a fresh machine when no earlier test in this worker has run the Kane model)
+    Fresh, Cached = kernel({}), kernel({"signature": "entry"})
 
     import contextlib
     import io
 
     buffer = io.StringIO()
     with contextlib.redirect_stderr(buffer):
-        announce_compile("test kernels", K.rhs, Fresh)
-        announce_compile("test kernels", K.rhs, Fresh)  # once per process
-        announce_compile("the cached kernels", K.rhs)
+        announce_compile("test kernels", Cached, Fresh)
+        announce_compile("test kernels", Cached, Fresh)  # once per process
+        announce_compile("the cached kernels", Cached)
     assert buffer.getvalue().count("\n") == 1 and buffer.getvalue().startswith("note: compiling test kernels with numba")
 
 
