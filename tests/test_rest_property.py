@@ -69,10 +69,12 @@ def _pose(x, r0=np.eye(3)):
     return x[:3], Rotation.from_rotvec(x[3:]).as_matrix() @ r0
 
 
-def _distances(data, com, rot):
-    com_body = np.array(data["body"]["com"])
-    return np.array([np.linalg.norm(np.array(w["anchor"]) - com - rot @ (np.array(w["attach"]) - com_body))
-                     for w in data["wire"]])
+def _distances(data):
+    """Each wire's anchor-to-attachment distance (m) as a function of the COM and the rotation (body ->
+    world); the arrays are built once, since the searches call it tens of thousands of times."""
+    anchors = np.array([w["anchor"] for w in data["wire"]])
+    arms = np.array([w["attach"] for w in data["wire"]]) - np.array(data["body"]["com"])
+    return lambda com, rot: np.linalg.norm(anchors - com - arms @ rot.T, axis=1)
 
 
 def independent_lowest_rigid(data, rng):
@@ -80,18 +82,19 @@ def independent_lowest_rigid(data, rng):
     there (distance within 1e-7 m of its length)."""
     lengths = np.array([w["length"] for w in data["wire"]])
     anchors = np.array([w["anchor"] for w in data["wire"]])
+    distances = _distances(data)
     best = None
     for k in range(STARTS):
         r0 = Rotation.random(random_state=rng).as_matrix()
         c0 = anchors.mean(axis=0) - [0, 0, lengths.mean() + 0.5]
         res = minimize(lambda x: x[2], np.concatenate([c0, np.zeros(3)]), method="SLSQP",
-                       constraints=[{"type": "ineq", "fun": lambda x: lengths - _distances(data, *_pose(x, r0))}],
+                       constraints=[{"type": "ineq", "fun": lambda x: lengths - distances(*_pose(x, r0))}],
                        options={"ftol": 1e-14, "maxiter": 500})
         com, rot = _pose(res.x, r0)
-        if np.max(_distances(data, com, rot) - lengths) > 1e-8:
+        if np.max(distances(com, rot) - lengths) > 1e-8:
             continue
         if best is None or com[2] < best[0]:
-            best = (com[2], bool(np.all(lengths - _distances(data, com, rot) < 1e-7)))
+            best = (com[2], bool(np.all(lengths - distances(com, rot) < 1e-7)))
     return best
 
 
@@ -101,10 +104,11 @@ def independent_lowest_elastic(data, rng):
     k = np.array([w["axial_stiffness"] for w in data["wire"]]) / lengths
     anchors = np.array([w["anchor"] for w in data["wire"]])
     weight = data["body"]["mass"] * 9.81
+    distances = _distances(data)
 
     def energy(x, r0):
         com, rot = _pose(x, r0)
-        stretch = np.maximum(_distances(data, com, rot) - lengths, 0.0)
+        stretch = np.maximum(distances(com, rot) - lengths, 0.0)
         return weight * com[2] + 0.5 * k @ stretch**2
 
     best, slack = np.inf, False
@@ -113,7 +117,7 @@ def independent_lowest_elastic(data, rng):
         c0 = anchors.mean(axis=0) - [0, 0, lengths.mean()]
         res = minimize(energy, np.concatenate([c0, np.zeros(3)]), args=(r0,), method="BFGS", options={"gtol": 1e-10})
         if res.fun < best:
-            best, slack = res.fun, bool(np.any(_distances(data, *_pose(res.x, r0)) <= lengths))
+            best, slack = res.fun, bool(np.any(distances(*_pose(res.x, r0)) <= lengths))
     return best, slack, energy
 
 
