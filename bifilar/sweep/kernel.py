@@ -35,8 +35,10 @@ def continued_modes(arms, anchors, lengths, mass, gravity, inertia, scale, com, 
     M-normalised eigenvector. ``status`` is :data:`OK` or why the general path must take over."""
     empty = np.zeros(0)
     weight = mass * gravity
+    # np.int64: a bare module-level int would be typed Literal[int] and compile newton_equilibrium
+    # a second time, beside the int64 signature rest_pose already compiled.
     com, rot, tensions, residual, _ = PK.newton_equilibrium(com, rot, tensions, arms, anchors, lengths, weight,
-                                                            scale, NEWTON_ITERATIONS)
+                                                            scale, np.int64(NEWTON_ITERATIONS))
     if not residual <= RESIDUAL:
         return NO_NEWTON, com, rot, tensions, empty, np.zeros((6, 0))
     if tensions.min() <= 0.0:
