@@ -1,4 +1,12 @@
-"""Shared fixtures: the shipped rigs and their Kane models; no compile notes inside the tests.
+"""Shared fixtures: the shipped rigs and their Kane models; hypothesis profiles; no compile notes inside
+the tests.
+
+Hypothesis profiles, registered once here (a test sets only ``max_examples``, the size its assertion
+needs): ``ci``, the default, draws the same examples on every run (derandomized, no example database),
+so that the suite fails on a change, not on a new draw: a draw that finds a defect becomes an
+``@example``; ``fuzz`` draws afresh, for the long profile (``python -m pytest -m fuzz``, or
+``HYPOTHESIS_PROFILE=fuzz`` for every property test). Neither has a deadline: an example's time depends on
+the machine's load and on whether numba has compiled yet.
 
 On an empty numba cache (a fresh machine running only the test command) the kernels compile at
 whichever test first loops over them, and their one-line note on stderr would land in that test's
@@ -7,10 +15,12 @@ tests run in. The notes are therefore marked as given for the whole session; tes
 them with a fresh record of its own.
 """
 
+import os
 import sys
 from pathlib import Path
 
 import pytest
+from hypothesis import HealthCheck, settings
 
 sys.path.insert(0, str(Path(__file__).parent))  # helper modules beside the tests (thesis_appendix)
 
@@ -19,6 +29,12 @@ from bifilar.motion.kane import KaneModel  # noqa: E402
 from validate.assets import rig  # noqa: E402
 
 jit._announced.add(jit.EVERYTHING)  # module docstring
+
+# Random rigs are built by filtering draws (a degenerate one is discarded) and some examples take seconds.
+_QUIET = [HealthCheck.filter_too_much, HealthCheck.too_slow, HealthCheck.data_too_large]
+settings.register_profile("ci", derandomize=True, database=None, deadline=None, suppress_health_check=_QUIET)
+settings.register_profile("fuzz", derandomize=False, database=None, deadline=None, suppress_health_check=_QUIET)
+settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "ci"))
 
 
 @pytest.fixture(params=["plate", "parallel", "asymmetric", "sidesway"])

@@ -138,6 +138,7 @@ def test_bad_air_table_is_one_line(tmp_path, capsys):
         assert err.count("\n") == 1 and str(path) in err and field in err
 
 
+@pytest.mark.slow
 def test_identify_recovers_the_wings_own_inertia_from_a_record_in_air(tmp_path, capsys):
     # A Kane record of the wing in air (added mass and drag) with 2e-4 rad of tracker noise: the
     # apparent moment holds the air; subtracting it must give the body's own I_zz within its sigma.

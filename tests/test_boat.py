@@ -220,6 +220,7 @@ def study():
     return run_study(SUSPENSION)
 
 
+@pytest.mark.slow
 def test_summary_has_the_brief_fields(study):
     data = json.loads(json.dumps(summary(study)))
     # models/solar_boat/README.md: 178.6 kg, COM 0.2051 m below the deck, pilot 44.0 %, moments

@@ -24,13 +24,13 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, given, settings
+from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from validate.assets import MODELS, RIGS
 from validate.cli import main
 
-PROFILES = [pytest.param("fast", id="fast"), pytest.param("long", id="long", marks=pytest.mark.fuzz)]
+PROFILES = [pytest.param("fast", id="fast"), pytest.param("long", id="long", marks=[pytest.mark.fuzz, pytest.mark.slow])]
 # examples per property: (fast, long); the long counts add up to 10,000.
 EXAMPLES = {"rig_text": (120, 3500), "extreme": (25, 1500), "simulate": (6, 500), "argv": (150, 3000),
             "signal": (15, 1000), "sweep": (40, 500)}
@@ -50,8 +50,7 @@ def _run(profile: str, name: str, strategy, check) -> None:
     """Run ``check`` on ``EXAMPLES[name]`` examples of ``strategy`` (fast or long profile)."""
     count = EXAMPLES[name][0 if profile == "fast" else 1]
 
-    @settings(max_examples=count, deadline=None, database=None, derandomize=profile == "fast",
-              suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large, HealthCheck.filter_too_much])
+    @settings(settings.get_profile("ci" if profile == "fast" else "fuzz"), max_examples=count)  # tests/conftest.py
     @given(strategy)
     def prop(example):
         check(example)
@@ -361,6 +360,7 @@ def test_signal_files(profile, tmp_path, capsys):
     _run(profile, "signal", _signal_csv(), check)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("profile", PROFILES)
 def test_malformed_sweep_files(profile, tmp_path, capsys):
     """A mutated shipped sweep file (next to a copy of the models its paths name): the loader gives a

@@ -135,6 +135,7 @@ def test_rigid_rod_chain_is_the_first_order_model_exactly():
     assert abs(massless_error) > 1e-3  # the wires' share is visible: 1.3e-3
 
 
+@pytest.mark.slow
 def test_first_order_correction_against_the_chain_at_small_ratio():
     """Parallel rig, wires 1 % of the body, 8 segments a wire. The first-order model leaves the second
     order (sag and lag of the flexible wire, measured 4e-3 eps^2 = 4e-7 here, 3.4e-7 with 16 segments:

@@ -157,6 +157,7 @@ def test_linear_and_monte_carlo_propagation_agree():
     assert mc.budget["anchor"] == pytest.approx(lin.budget["anchor"], abs=0.15)
 
 
+@pytest.mark.slow
 def test_the_95_percent_interval_covers_the_truth_95_percent_of_the_time():
     trials = 200
     result = coverage(rig("bench_plate"), "z", trials, np.random.default_rng(11))
@@ -233,6 +234,7 @@ def torsion_csv(tmp_path, name, amplitude, seed, noise=1e-3, axis="z"):
     return str(path)
 
 
+@pytest.mark.slow
 def test_cli_signals_are_pooled_trials(main, capsys, tmp_path):
     """Two Kane records (0.1 and 0.8 rad) through the exact torsion law: each and the pooled moment
     within 3 sigma of the truth; the trials' chi^2 is reported."""
@@ -248,6 +250,7 @@ def test_cli_signals_are_pooled_trials(main, capsys, tmp_path):
     assert out["amplitude"] is None  # per-record quantities live in the trials when there are several
 
 
+@pytest.mark.slow
 def test_cli_signal_about_a_swing_axis_uses_the_kane_series(main, capsys, tmp_path):
     """About x (the plate turning about the wire line, a swing, not a 1-DOF torsion) the law is the
     Kane model's period-amplitude series: at 0.3 rad its O(A^4) error is below the record's sigma."""
@@ -341,6 +344,7 @@ def test_cli_record_that_cannot_be_used_names_it(main, capsys, tmp_path):
     assert "no oscillation stands out of the noise" in err or "cycles could be measured on their own" in err
 
 
+@pytest.mark.slow
 def test_png_is_written(main, capsys, tmp_path):
     path = torsion_csv(tmp_path, "a.csv", 0.5, 5)
     png = tmp_path / "fit.png"
@@ -348,6 +352,7 @@ def test_png_is_written(main, capsys, tmp_path):
     assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
 
 
+@pytest.mark.slow
 def test_cli_signal_of_a_trifilar_platform(main, capsys, tmp_path):
     """A trifilar video record: the N-wire model released at 0.5 rad, 20 cycles, frames at 120 fps with
     no time column, 0.005 rad of noise, an offset. The platform is symmetric, so the fit uses the exact

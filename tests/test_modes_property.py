@@ -15,7 +15,7 @@ inertia tensors; and three-wire platforms.
 
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, assume, given, settings
+from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 from scipy.spatial.transform import Rotation
 
@@ -144,13 +144,14 @@ def _check(data):
     assert all(m.period is None or m.omega2 > NEUTRAL_RTOL * top for m in lin.modes)
 
 
-@settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.filter_too_much])
+@settings(max_examples=25)
 @given(two_wire_rigs())
 def test_two_wire_modes_match_an_independent_linearisation(data):
     _check(data)
 
 
-@settings(max_examples=15, deadline=None, suppress_health_check=[HealthCheck.filter_too_much])
+@pytest.mark.slow
+@settings(max_examples=15)
 @given(three_wire_rigs())
 def test_three_wire_modes_match_an_independent_linearisation(data):
     _check(data)

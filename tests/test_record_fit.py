@@ -46,6 +46,7 @@ def test_matched_quintic_holds_both_ends_of_the_amplitude_range():
     assert matched.ratio(0.05, omega) == pytest.approx(law.ratio(0.05, omega), abs=1e-7)
 
 
+@pytest.mark.slow
 def test_noise_free_decay_recovers_t0_and_the_excess():
     """The rod from 1.2 rad, a law 30 % stronger than the ideal one, quadratic damping to 0.4 rad,
     1e-6 rad of noise: T0 to 5e-6 (what the three-term excess leaves of a cubic one over 0.4-1.2 rad,
@@ -62,6 +63,7 @@ def test_noise_free_decay_recovers_t0_and_the_excess():
     assert fit.amplitude[1] < 0.6
 
 
+@pytest.mark.slow
 def test_a_swing_that_stays_large_keeps_its_own_third_harmonic():
     """The rod released at 1.2 rad with hardly any damping (1.2 -> 1.18 rad over 80 cycles), the ideal
     law, 1e-4 rad of noise: it swings 9 % below its zero-swing frequency all along, and its waveform's
@@ -78,6 +80,7 @@ def test_a_swing_that_stays_large_keeps_its_own_third_harmonic():
     assert abs(fit.period - rec.period) < 3.0 * fit.period_std
 
 
+@pytest.mark.slow
 def test_the_ideal_law_alone_is_biased_and_the_learned_one_is_not():
     """A record whose real law is 30 % stronger: held at the ideal law (--law-sigma 0) its T0 is off by
     more than 3 of its sigmas (the cycles' sandwich widens with the misfit: 3.8 here) and by 2e-3 of
@@ -91,6 +94,7 @@ def test_the_ideal_law_alone_is_biased_and_the_learned_one_is_not():
     assert abs(learned.period - rec.period) < abs(held.period - rec.period) / 3.0
 
 
+@pytest.mark.slow
 def test_a_record_that_barely_decays_carries_the_laws_doubt():
     """At 0.8 rad with no decay the record cannot tell T0 from the law: its sigma is the prior's doubt
     (0.35 of s A^2 and more: ~1 % of T0), and it still covers a law 30 % stronger."""
@@ -102,6 +106,7 @@ def test_a_record_that_barely_decays_carries_the_laws_doubt():
     assert abs(fit.period - rec.period) < 3.0 * fit.period_std
 
 
+@pytest.mark.slow
 def test_a_tracker_locking_on_losing_frames_and_sticking_is_fitted_and_says_what_it_left_out():
     """The issue's refused record: 94 cycles at 60 fps, 12 % of frames lost in runs, a lock-on of 1.5 s
     with values stuck at exactly -pi/4, a tracker that repeats values: fitted, T0 within 3 sigma, the
@@ -119,6 +124,7 @@ def test_a_tracker_locking_on_losing_frames_and_sticking_is_fitted_and_says_what
     assert fit.cycles >= 0.8 * 94  # the lock-on's 1.5 cycles and the runs of lost frames left out
 
 
+@pytest.mark.slow
 def test_folded_line_tracker_record():
     rec = Y.record(BENCH, np.random.default_rng(12), Y.Traits(amplitude=0.9, cycles=30, fold=True, white=0.004))
     y, jumps = unfold(rec.y)
@@ -140,6 +146,7 @@ def test_a_second_mode_close_to_the_first_is_found_and_taken_out():
     assert abs(fit.period - rec.period) < 3.0 * fit.period_std < 1.4e-2 * rec.period
 
 
+@pytest.mark.slow
 def test_laser_spot_of_unknown_scale_is_the_plain_fits_period():
     """240 fps laser spots (pixels, scale unknown) over 6 cycles that hardly decay, a sway at 1.95 T0
     beating in (the issue's degenerate and short records), six draws: T0 near the period at the
@@ -159,6 +166,7 @@ def test_laser_spot_of_unknown_scale_is_the_plain_fits_period():
     assert math.sqrt(float(np.mean(np.square(z)))) < 1.8 and max(np.abs(z)) < 3.5
 
 
+@pytest.mark.slow
 def test_a_stated_largest_swing_applies_the_law_and_its_doubt():
     """The same kind of record with --max-amplitude 0.12 rad (truth 0.08): the law is applied with the
     scale fitted in [0, 0.12 / first amplitude], T0 within 3 sigma of the zero-amplitude truth."""
@@ -169,6 +177,7 @@ def test_a_stated_largest_swing_applies_the_law_and_its_doubt():
     assert abs(fit.period - rec.period) < 3.0 * fit.period_std
 
 
+@pytest.mark.slow
 def test_white_noise_sigma_is_honest_and_efficient():
     """40 short clean records: the 95 % intervals hold the truth within the binomial 99.9 % range, and
     the statistical sigma is within 1.3x of a plain damped-sine least-squares fit's in the median and
@@ -186,6 +195,7 @@ def test_white_noise_sigma_is_honest_and_efficient():
     assert np.median(ratio) < 1.3 and max(ratio) < 2.5
 
 
+@pytest.mark.slow
 def test_two_halves_of_a_coloured_record_agree():
     """A 120-cycle record with noise correlated over half a second: its halves, fitted alone, agree
     within 3 of their sigmas (the law's common prior taken out); the block sigma is above the white."""
@@ -198,6 +208,7 @@ def test_two_halves_of_a_coloured_record_agree():
     assert abs(split.z) < 3.0
 
 
+@pytest.mark.slow
 def test_interval_coverage_on_records_with_every_trait():
     """12 video records with every trait: the 95 % intervals hold the truth within the binomial 99.9 %
     range of 12 draws; the 90-record run is the slow case identify-record-coverage."""
@@ -252,6 +263,7 @@ def test_a_swing_the_rig_cannot_make_is_refused_naming_the_unit(kind, scale, uni
     assert err.value.source == "log.csv" and err.value.field == "value"
 
 
+@pytest.mark.slow
 def test_pooling_shares_the_laws_prior():
     """Two records of one rig at one amplitude that cannot learn the law: their T0 share its doubt, so
     the pooled sigma is not that doubt over sqrt(2) (independent noise) but the doubt itself."""
@@ -265,6 +277,7 @@ def test_pooling_shares_the_laws_prior():
     assert pooled.period_std > 0.9 * min(f.period_std_law for f in fits)
 
 
+@pytest.mark.slow
 def test_a_law_no_rig_has_is_flagged_by_identify():
     """A record of the bench plate whose periods follow a law 4x the ideal one in A^2 (a rig file whose
     law is wrong, or a beat read as a chirp): identify says so, names what to check, and says that T0 is

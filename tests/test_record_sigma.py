@@ -17,6 +17,7 @@ ROD = L.TorsionRig.parallel(0.5, 0.0016, 0.8, 0.196)
 LAW = AmplitudeLaw.torsion(ROD)
 
 
+@pytest.mark.slow
 def test_the_jackknife_widens_a_covariance_that_coloured_noise_leaves_short(monkeypatch):
     # 100 cycles from 0.8 rad with AR(1) noise of 6.6 mrad over 0.12 s (a video tracker's), a law 25 %
     # stronger than the ideal: over 16 such records T0 scattered 1.9x the covariance's sigma
@@ -42,6 +43,7 @@ def test_the_covariance_holds_on_a_short_clean_record(seed):
     assert fit.jackknife == 0
 
 
+@pytest.mark.slow
 def test_a_law_no_rig_has_is_said_and_its_sigma_holds_both_periods():
     # a law 4x the ideal's in its A^2 coefficient (excess 3.0: the prior allows +-35 %, real rigs up to
     # 30-40 %): the fit learns ~2.3 of it, 9 prior sigmas off, and T0 under the ideal law is 11 % away;
@@ -55,6 +57,7 @@ def test_a_law_no_rig_has_is_said_and_its_sigma_holds_both_periods():
     assert abs(fit.period - rec.period) < 1.0 * fit.period_std  # the learned T0 is the near one (0.6 %)
 
 
+@pytest.mark.slow
 def test_a_law_a_real_rig_has_is_learned_not_held():
     # the same record with a law 40 % stronger, the most real rigs show: learned, not flagged
     rec = Y.record(ROD, np.random.default_rng(1), Y.Traits(amplitude=0.8, cycles=40.0, excess=0.4, white=0.003,
@@ -64,6 +67,7 @@ def test_a_law_a_real_rig_has_is_learned_not_held():
     assert abs(fit.period - rec.period) < 3.0 * fit.period_std  # 3 sigma: one draw
 
 
+@pytest.mark.slow
 def test_a_mode_beating_near_the_torsion_is_not_read_as_a_law():
     # a 250 Hz gyro record of 25 cycles from 0.22 rad with a sway at 0.9675 T0 (2.5 % of the swing):
     # less than one beat over the record, its slow phase wobble reads as a chirp, and the law learned
@@ -79,6 +83,7 @@ def test_a_mode_beating_near_the_torsion_is_not_read_as_a_law():
     assert abs(fit.period - rec.period) < 1.96 * fit.period_std
 
 
+@pytest.mark.slow
 def test_a_narrow_range_of_swings_carries_the_law_s_extrapolation():
     # The rod from 1.2 rad to 1.05 over 80 cycles (light viscous damping), the ideal law, 1e-4 rad of
     # white noise: the three excess terms, fixed by the law's value, slope and curvature over that

@@ -6,6 +6,7 @@ by cycle."""
 from __future__ import annotations
 
 import numpy as np
+import pytest
 from rrd_check import timeline, verify, views
 from test_recording import read, scalars
 
@@ -24,6 +25,7 @@ def _check_layout(path) -> None:
     assert {k: shown.get(k) for k in LAYOUT} == LAYOUT
 
 
+@pytest.mark.slow
 def test_simulate_case_and_all_recordings_verify_and_open_on_their_layout(tmp_path, capsys):
     assert main(["simulate", str(RIGS / "plate.toml"), "--engine", "kane", "--duration", "8", "--out",
                  str(tmp_path / "p.csv"), "--rerun", str(tmp_path / "simulate.rrd")]) == 0

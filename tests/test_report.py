@@ -49,6 +49,7 @@ def _mask_times(text: str) -> str:
     return re.sub(r'(time|timestamp)="[^"]*"', r'\1="*"', text)
 
 
+@pytest.mark.slow
 def test_junit_of_two_identical_runs_differs_only_in_times_and_lists_failed_metrics(tmp_path, capsys, failing_case):
     texts = []
     for k in range(2):
@@ -116,6 +117,7 @@ def test_page_orders_failed_cases_first_and_escapes_text():
     assert len(page.images) == 1  # the good case's comparison
 
 
+@pytest.mark.slow
 def test_html_names_every_case_and_metric_and_renders(tmp_path, capsys, failing_case):
     path = tmp_path / "report.html"
     code = main(["all", "-k", CASES, "--jobs", "1", "--html", str(path)])
@@ -163,6 +165,7 @@ def test_an_unwritable_report_path_is_exit_2_before_any_case_runs(tmp_path, caps
                                 "error: /proc/nope/j.xml: cannot write (No such file or directory)"]
 
 
+@pytest.mark.slow
 def test_slow_html_ends_with_the_stored_speed_accuracy_result(tmp_path, capsys):
     from validate.report.speed_accuracy import SpeedAccuracySection, load
 

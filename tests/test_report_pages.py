@@ -8,6 +8,7 @@ import csv
 import json
 
 import numpy as np
+import pytest
 
 from page_check import check_not_blank, check_self_contained, page_text, render
 from test_identify import BENCH, torsion_csv, write_rig
@@ -24,6 +25,7 @@ def _identify(capsys, *args) -> dict:
     return json.loads(capsys.readouterr().out)
 
 
+@pytest.mark.slow
 def test_identify_page_of_two_records(tmp_path, capsys):
     records = [torsion_csv(tmp_path, "a.csv", 0.1, 3), torsion_csv(tmp_path, "b.csv", 0.5, 4)]
     path = tmp_path / "identify.html"
@@ -57,6 +59,7 @@ def test_identify_page_of_a_period_with_a_tare(tmp_path, capsys):
     assert f"rig: {combined}" in words and f"fixture: {BENCH}" in words
 
 
+@pytest.mark.slow
 def test_sweep_writes_a_report_page_of_its_outputs(tmp_path, capsys):
     from test_sweep_rerun import _sweep
 
@@ -86,6 +89,7 @@ def test_sweep_writes_a_report_page_of_its_outputs(tmp_path, capsys):
     assert f"{100.0 * best['objective']:.4g} %" in dom and "MuJoCo check" in dom
 
 
+@pytest.mark.slow
 def test_the_sweep_page_reads_its_csv_in_bounded_memory(tmp_path):
     """30,000 rows (~5 MB of CSV, ~60 MB as row dicts) reduced with a peak of a few MB: the cells
     (here 300 x 100 values in 200 x 100 cells), the sample of at most 20,000 feasible rows (every

@@ -14,7 +14,7 @@ refused naming a wire or is a higher stable taut equilibrium. Never a traceback,
 
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, example, given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 from scipy.optimize import minimize
 from scipy.spatial.transform import Rotation
@@ -121,9 +121,10 @@ def independent_lowest_elastic(data, rng):
     return best, slack, energy
 
 
-# derandomize: the same draws on every run, so that CI fails on a change, not on a new draw; a draw
-# that finds a defect becomes an @example or, until fixed, a strict xfail below
-@settings(max_examples=20, deadline=None, suppress_health_check=[HealthCheck.filter_too_much], derandomize=True)
+# the ci profile draws the same rigs on every run (tests/conftest.py); a draw that finds a defect
+# becomes an @example or, until fixed, a strict xfail below
+@pytest.mark.slow
+@settings(max_examples=20)
 @given(seed=st.integers(0, 2**32 - 1), n=st.integers(3, 6))
 @example(seed=101471, n=3)  # a trifilar whose two first starts stopped 17 mm above its lowest taut pose
 def test_rigid_rest_pose_is_the_lowest(seed, n):
@@ -150,7 +151,8 @@ def test_rigid_rest_pose_is_the_lowest(seed, n):
     # minimum of the potential: the body can hang there), which rest_pose checked.
 
 
-@settings(max_examples=10, deadline=None, derandomize=True)
+@pytest.mark.slow
+@settings(max_examples=10)
 @given(seed=st.integers(0, 2**32 - 1), n=st.integers(3, 8))
 @example(seed=371995, n=5)  # the two first starts ended slack, a taut minimum lies lower (was refused)
 @example(seed=109851, n=5)  # the lowest minimum is slack, a taut one 0.5 J above it
@@ -176,6 +178,7 @@ def test_elastic_rest_pose_is_the_lowest(seed, n):
     assert ours >= best - 1e-9 * data["body"]["mass"] * 9.81  # never below the lowest: a true minimum
 
 
+@pytest.mark.slow
 @pytest.mark.xfail(strict=True, reason="open defect (issue 20's class): a random six-wire rig whose lowest pose "
                    "is taut is refused, every start ending with wire 1 slack (found by CI's draw, seed 837)")
 def test_six_wire_rig_837_hangs_at_its_lowest_taut_pose():
@@ -184,3 +187,9 @@ def test_six_wire_rig_837_hangs_at_its_lowest_taut_pose():
     assert reference is not None and reference[1]  # the lowest pose is taut
     rest = rest_pose(rig_from_dict(data, source="fuzz.toml"))
     assert rest.com[2] <= reference[0] + 1e-7
+
+
+def test_a_trifilar_rests_at_its_lowest_taut_pose():
+    """The quick tier's case of the rigid property (one rig, not twenty): the trifilar whose two first
+    starts stopped 17 mm above its lowest taut pose."""
+    test_rigid_rest_pose_is_the_lowest.hypothesis.inner_test(seed=101471, n=3)

@@ -273,12 +273,14 @@ def _cli(*args, **kwargs):
                           text=True, timeout=120, **kwargs)
 
 
+@pytest.mark.slow
 def test_a_closed_pipe_is_quiet():
     proc = subprocess.run(f"{sys.executable} -m validate list | head -c 10", shell=True, cwd=ROOT,
                           capture_output=True, text=True, timeout=120)
     assert proc.returncode == 0 and "Error" not in proc.stderr and "error" not in proc.stderr, proc.stderr
 
 
+@pytest.mark.slow
 def test_ctrl_c_is_one_line_and_exit_130(tmp_path):
     proc = subprocess.Popen([sys.executable, "-m", "validate", "simulate", str(RIGS / "plate.toml"), "--duration",
                              "900", "--out", str(tmp_path / "x.csv")], cwd=ROOT, stdout=subprocess.PIPE,
@@ -292,13 +294,21 @@ def test_ctrl_c_is_one_line_and_exit_130(tmp_path):
     assert not (tmp_path / "x.csv").exists() and list(tmp_path.iterdir()) == []
 
 
-def test_help_lists_exit_codes_an_example_and_option_units():
-    proc = _cli("--help")
-    assert proc.returncode == 0
+def _help(capsys, monkeypatch, *verb) -> str:
+    """``python -m validate [VERB] --help`` as a process with its output piped prints it (in-process: the
+    same parser, without a second interpreter's ~2 s of imports); argparse wraps at COLUMNS, 80 in a pipe."""
+    monkeypatch.setenv("COLUMNS", "80")
+    code, out, err = run_cli(capsys, *verb, "--help")
+    assert code == 0 and not err, err
+    return out
+
+
+def test_help_lists_exit_codes_an_example_and_option_units(capsys, monkeypatch):
+    top = _help(capsys, monkeypatch)
     for text in ("exit status:", "  4    a run that failed", "  130  interrupted", "examples:",
                  "python -m validate modes models/rigs/plate.toml"):
-        assert text in proc.stdout, text
-    sim = _cli("simulate", "--help").stdout
+        assert text in top, text
+    sim = _help(capsys, monkeypatch, "simulate")
     for text in ("{kane,nwire,mujoco,mujoco-eq,mujoco-cable}", "simulated time, s", "(default: 0.01)", "(default: 1e-10",
                  "wall-time budget of the run, s"):
         assert text in " ".join(sim.split()), text
@@ -414,12 +424,12 @@ def test_the_rig_file_doc_states_the_wire_count_the_reader_accepts():
 
 @pytest.mark.parametrize("verb", ["all", "list", "case", "modes", "simulate", "mjcf", "identify", "boat", "sweep",
                                   "tensor", "plan"])
-def test_every_verbs_help_lists_exactly_its_exit_statuses(verb):
+def test_every_verbs_help_lists_exactly_its_exit_statuses(verb, capsys, monkeypatch):
     """One source (validate/statuses.py): each verb's --help lists the statuses it can return, no
     others, within 100 columns."""
     from validate.statuses import COMMANDS
 
-    out = _cli(verb, "--help").stdout
+    out = _help(capsys, monkeypatch, verb)
     block = out.split("exit status:\n")[1].split("\n\n")[0].splitlines()
     listed = [int(line.split()[0]) for line in block if not line.startswith("       ")]
     assert listed == sorted(COMMANDS[verb])

@@ -67,6 +67,7 @@ def test_parallel_yaw_sigma_matches_the_closed_form_propagation(tmp_path):
         assert row.tensions == pytest.approx((m * 9.81 / 2, m * 9.81 / 2), rel=1e-12)  # vertical wires
 
 
+@pytest.mark.slow
 def test_every_csv_field_against_an_independent_computation(tmp_path, capsys):
     path = _write(
         tmp_path,
@@ -131,6 +132,7 @@ def test_peak_tension_against_the_kane_model():
     assert (ours - rest.tensions.max()) == pytest.approx(kane - rest.tensions.max(), rel=0.05)
 
 
+@pytest.mark.slow
 def test_dask_cluster_gives_the_local_rows_bit_for_bit_and_a_sweep_resumes(tmp_path):
     from dask.distributed import Client, LocalCluster
 

@@ -73,6 +73,7 @@ def test_a_warning_inside_rollout_fails_the_batch():
         mujoco_rig.run_batch([mujoco_rig.BatchRun(bench, 0.02, 0.01), mujoco_rig.BatchRun(bench, 0.02, 0.01, bad)])
 
 
+@pytest.mark.slow
 def test_the_batched_check_is_the_sequential_check():
     """The best configuration of the small bench-plate sweep (the case sweep-mujoco-check's) and one
     more, x, y and z each: every number of the check equal, to 1e-12 (measured: the periods bit for

@@ -4,6 +4,7 @@ the text and the figure; the summary names every file written."""
 import json
 
 import numpy as np
+import pytest
 
 from bifilar.sweep.choose import edges
 from validate.cli import main
@@ -19,6 +20,7 @@ def test_edges_name_the_axis_side_and_direction():
     assert edges(axes, None) == [] and edges(axes, top, explicit=True) == []
 
 
+@pytest.mark.slow
 def test_the_shipped_sweep_warns_of_its_edges(tmp_path, capsys):
     # bench_plate's best (anchor span 0.9 m, attachment span 0.2 m) sits on two edges of its grid
     assert main(["sweep", "bench_plate", "--out", str(tmp_path), "--png", "--jobs", "1"]) == 0

@@ -45,6 +45,7 @@ def test_a_truncated_chunk_does_not_fail_the_command(tmp_path, capsys):
     assert err.count("\n") == 1 and "000000.json is unreadable (truncated?): recomputing it" in err, err
 
 
+@pytest.mark.slow
 def test_an_unreachable_scheduler_is_exit_2_within_seconds(tmp_path):
     """In a process of its own, so that the wall time counts the imports and Dask's shutdown too."""
     import subprocess

@@ -8,6 +8,7 @@ import json
 import time
 
 import numpy as np
+import pytest
 from rerun.chunk import RrdReader
 from rrd_check import timeline, verify, views
 
@@ -39,6 +40,7 @@ def _sweep(tmp_path, *extra):
     return main([str(a) for a in ("sweep", tmp_path / "space.toml", "--out", tmp_path / "out", "--jobs", 1, *extra)])
 
 
+@pytest.mark.slow
 def test_rerun_holds_the_table_and_the_mujoco_motion(tmp_path, capsys):
     assert _sweep(tmp_path, "--rerun", "--check-mujoco", 1) == 0
     out = tmp_path / "out"

@@ -8,6 +8,7 @@ import json
 import math
 import types
 
+import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
@@ -41,7 +42,7 @@ _ROW = st.fixed_dictionaries({
 })
 
 
-@settings(max_examples=300, deadline=None, database=None)
+@settings(max_examples=300)
 @given(rows=st.lists(_ROW, max_size=40), keep=st.integers(1, 6))
 def test_the_reduction_as_rows_pass_is_the_whole_lists(rows, keep):
     choice = Choice(MEASURED, KIND, keep=keep)
@@ -59,6 +60,7 @@ SPACE = ('rig = "rig.toml"\n[vary]\nanchor_span = [0.4, 0.7, 1.0]\nwire_length =
          '[measure]\naxes = ["z"]\n')
 
 
+@pytest.mark.slow
 def test_the_outputs_are_the_same_whatever_the_chunk_size(tmp_path, capsys, monkeypatch):
     """Nine configurations in one chunk, in three (4, 4, 1) and in nine: sweep.csv, summary.json,
     sweep.png, report.html, the recording's table and map, and what is printed, all equal. Each row is

@@ -49,6 +49,7 @@ def test_held_part_is_kept_and_gradient_is_exact():
         assert grad[k] == pytest.approx((hi - lo) / (2 * h), rel=1e-5)
 
 
+@pytest.mark.slow
 def test_seven_hangings_from_exact_periods(tmp_path, capsys):
     # Hidden-hangings shape: a body with products of inertia and an offset COM on three wires in
     # seven orientations, [body] the same table in each file (object axes, inertia nan).
@@ -76,6 +77,7 @@ def test_seven_hangings_from_exact_periods(tmp_path, capsys):
     assert "principal 3:" in capsys.readouterr().out and (tmp_path / "t.html").stat().st_size > 2000
 
 
+@pytest.mark.slow
 def test_tare_shared_and_subtracted_exactly(tmp_path, capsys):
     # The object is ~2 % of the assembly's moment: the subtraction must be exact (parallel axes, the
     # linearisation on both rigs) for the tensor to come back to 1e-7 of its largest component.
@@ -142,6 +144,7 @@ def test_bad_hangings_files_are_one_line_exit_2(tmp_path, capsys, edit, message)
     assert message in err and err.count("\n") == 1 and "Traceback" not in err
 
 
+@pytest.mark.slow
 def test_plan_beats_the_textbook_hangings(tmp_path, capsys):
     body = (tmp_path / "rig.toml")
     text = open(rig("trifilar").source).read()
@@ -158,6 +161,7 @@ def test_plan_beats_the_textbook_hangings(tmp_path, capsys):
     assert "period_std: missing" in capsys.readouterr().err
 
 
+@pytest.mark.slow
 def test_hangings_from_records_and_a_tare_from_its_record(tmp_path, capsys):
     # Seven laser-spot records (pixels, scale unknown, --max-amplitude) through the hangings file:
     # each component within 4 of its stated sigmas (a record fit's sigma, not an exact period).
@@ -189,6 +193,7 @@ def test_hangings_from_records_and_a_tare_from_its_record(tmp_path, capsys):
     assert np.abs(z).max() < 4.0, z
 
 
+@pytest.mark.slow
 def test_a_tare_with_unknown_moments_is_taken_as_a_flat_platform(tmp_path, capsys):
     # The trifilar disc is a flat platform (I_xx = I_yy = I_zz / 2 to 1e-3: it is 2 cm thick): a tare
     # file with all three moments nan measures I_zz and takes the others as half of it, says so, and
