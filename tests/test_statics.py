@@ -91,11 +91,19 @@ def test_rest_pose_does_not_depend_on_the_body_frame(turn):
 def test_the_rest_search_slopes_are_the_rotation_s_derivatives(v):
     # d(R(v) r)/dv = -[R(v) r]x J_l(v), the constraint Jacobian SLSQP is given in the rest-pose search:
     # against central differences of scipy's rotation (step 1e-6: truncation ~1e-12, rounding ~1e-10).
-    from bifilar.rig.statics import _left_jacobian
+    from bifilar.rig.statics import _left_jacobian, _skew
 
     v, r, h = np.array(v), np.array([0.2, -0.5, 0.7]), 1e-6
     numeric = np.column_stack([(Rotation.from_rotvec(v + h * e).apply(r) - Rotation.from_rotvec(v - h * e).apply(r))
                                / (2.0 * h) for e in np.eye(3)])
     turned = Rotation.from_rotvec(v).apply(r)
-    skew = np.array([[0.0, -turned[2], turned[1]], [turned[2], 0.0, -turned[0]], [-turned[1], turned[0], 0.0]])
-    np.testing.assert_allclose(-skew @ _left_jacobian(v), numeric, atol=1e-9)
+    np.testing.assert_allclose(-_skew(turned) @ _left_jacobian(v), numeric, atol=1e-9)
+
+
+@pytest.mark.parametrize("v", [[0.3, -1.1, 2.0], [1e-8, 0.0, 2e-8], [4e-7, -9e-7, 0.0], [0.0, 0.0, 3.1]])
+def test_the_rest_search_rotation_is_scipy_s(v):
+    # Rodrigues' formula (the search's inner loop) against scipy's quaternion route: the same matrix to a
+    # few units of rounding (entries of order 1), on both sides of the series' switch at |v| = 1e-6.
+    from bifilar.rig.statics import _rotation
+
+    np.testing.assert_allclose(_rotation(np.array(v)), Rotation.from_rotvec(v).as_matrix(), rtol=0, atol=4e-16)

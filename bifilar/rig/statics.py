@@ -315,23 +315,31 @@ def _search(rig: Rig, start: np.ndarray) -> Rest:
         com0 = guess
 
     turned = np.einsum("ij,wj->wi", rotation0, arms(rig))  # the arms at rotvec 0 (world frame)
-    ends = anchors(rig)
+    ends, wire_length = anchors(rig), lengths(rig)
     height = np.array([0.0, 0.0, 1.0 / scale, 0.0, 0.0, 0.0])
+    last: dict = {}  # SLSQP asks for the lengths and their slopes at the same x: one evaluation serves both
 
     def spans(x):
         """The arms turned by rotvec x[3:6] and the anchor-to-attachment vectors (world, m)."""
-        r = Rotation.from_rotvec(x[3:6]).apply(turned)
-        return r, x[:3] + r - ends
+        key = x.tobytes()
+        if last.get("x") != key:
+            r = turned @ _rotation(x[3:6]).T
+            last.update(x=key, spans=(r, x[:3] + r - ends))
+        return last["spans"]
 
     def wire_lengths(x):
-        return (np.linalg.norm(spans(x)[1], axis=1) - lengths(rig)) / scale
+        s = spans(x)[1]
+        return (np.sqrt(np.einsum("wi,wi->w", s, s)) - wire_length) / scale
 
     def wire_slopes(x):
         # d|s_i|/dx: the unit span u_i for the COM, and u_i . d(R r_i)/dv = u_i . (-[R r_i]x J_l(v))
-        # = (R r_i x u_i) . J_l(v) for the rotation vector v (J_l its left Jacobian on SO(3))
+        # = (R r_i x u_i) . J_l(v) for the rotation vector v (J_l its left Jacobian on SO(3)); the cross
+        # products written out (np.cross's axis handling was a tenth of the search's time)
         r, s = spans(x)
-        u = s / np.linalg.norm(s, axis=1)[:, None]
-        return np.hstack([u, np.cross(r, u) @ _left_jacobian(x[3:6])]) / scale
+        u = s / np.sqrt(np.einsum("wi,wi->w", s, s))[:, None]
+        (rx, ry, rz), (ux, uy, uz) = r.T, u.T
+        turn = np.column_stack((ry * uz - rz * uy, rz * ux - rx * uz, rx * uy - ry * ux))
+        return np.hstack([u, turn @ _left_jacobian(x[3:6])]) / scale
 
     coarse = minimize(
         lambda x: x[2] / scale,
@@ -383,11 +391,27 @@ def _search(rig: Rig, start: np.ndarray) -> Rest:
     return rest
 
 
+def _rotation(v: np.ndarray) -> np.ndarray:
+    """exp([v]x) by Rodrigues' formula, I + sin t / t K + (1 - cos t) / t^2 K^2 (K = [v]x, t = |v|): the
+    search's inner loop, where scipy's Rotation (a quaternion object per call) took two thirds of the
+    time; the same matrix to rounding (tests/test_statics.py)."""
+    t = float(np.linalg.norm(v))
+    k = _skew(v)
+    if t < 1e-6:  # the series: 1 - t^2/6 and 1/2 - t^2/24
+        return np.eye(3) + (1.0 - t * t / 6.0) * k + (0.5 - t * t / 24.0) * (k @ k)
+    return np.eye(3) + math.sin(t) / t * k + (1.0 - math.cos(t)) / t**2 * (k @ k)
+
+
+def _skew(v: np.ndarray) -> np.ndarray:
+    """[v]x, the matrix of the cross product v x ."""
+    return np.array([[0.0, -v[2], v[1]], [v[2], 0.0, -v[0]], [-v[1], v[0], 0.0]])
+
+
 def _left_jacobian(v: np.ndarray) -> np.ndarray:
     """J_l(v) = I + (1 - cos t) / t^2 K + (t - sin t) / t^3 K^2 (K = [v]x, t = |v|): exp([v + dv]x) =
     exp([J_l dv]x) exp([v]x) to first order, so d(R(v) r) / dv = -[R(v) r]x J_l(v)."""
     t = float(np.linalg.norm(v))
-    k = np.array([[0.0, -v[2], v[1]], [v[2], 0.0, -v[0]], [-v[1], v[0], 0.0]])
+    k = _skew(v)
     if t < 1e-6:  # the series: 1/2 - t^2/24 and 1/6 - t^2/120
         return np.eye(3) + (0.5 - t * t / 24.0) * k + (1.0 / 6.0 - t * t / 120.0) * (k @ k)
     return np.eye(3) + (1.0 - math.cos(t)) / t**2 * k + (t - math.sin(t)) / t**3 * (k @ k)

@@ -1335,8 +1335,9 @@ def damping_shift(damping: dict, amplitude: np.ndarray) -> np.ndarray:
     friction (zeta_eff the decrement per radian), ~1e-5 of the period for a hardly damped video record
     released at 1 rad, as large as its statistical sigma. So it is measured: one and a half cycles of
     theta'' + theta = -2 zeta theta' - c |theta'| theta' - m tanh(theta' / eps) from each amplitude (a
-    grid, RK4 at 256 steps per cycle: the shift to ~1e-3 of itself), the period from descending
-    crossing to descending crossing, and the amplitude half way (the trough) it belongs to."""
+    grid, RK4 at 256 steps per cycle: the shift to ~1e-3 of itself, for at most three cycles: a swing
+    that dry friction stops has no second crossing), the period from descending crossing to descending
+    crossing, and the amplitude half way (the trough) it belongs to."""
     zeta, quad, dry = damping["linear"], damping["quadratic"], damping["dry"]
     amplitude = np.asarray(amplitude, dtype=float)
     if zeta == quad == dry == 0.0 or not len(amplitude):
@@ -1366,6 +1367,8 @@ def damping_shift(damping: dict, amplitude: np.ndarray) -> np.ndarray:
         crossings[0] = np.where(down & first, at, crossings[0])
         trough = np.maximum(trough, np.where(np.isnan(crossings[1]) & ~first, -new, 0.0))
         th, v = new, new_v
+        if not np.isnan(crossings[1]).any():  # every cycle measured (the rest would change nothing)
+            break
     shift = (crossings[1] - crossings[0]) / (2.0 * math.pi) - 1.0
     ok = np.isfinite(shift) & (trough > 0.0)
     if ok.sum() < 2:
