@@ -62,6 +62,7 @@ from scipy.signal import lombscargle
 from scipy.stats import chi2, norm
 from scipy.stats import t as student_t
 
+from .bounds import window_centres
 from .clean import OUTLIER_Z, Rejected, spans, stuck
 from .law import EXCESS_PRIOR, LINEAR, AmplitudeLaw, Table
 from .read import KINDS, MIN_SAMPLES
@@ -185,6 +186,7 @@ class _Record:
     kind: str
     usable: np.ndarray  # not stuck, not a glitch
     step: float  # median sample spacing, s
+    omega: float = math.nan  # the record's own frequency, rad/s (:func:`_rough_frequency`)
 
 
 @dataclass
@@ -230,7 +232,7 @@ def fit_oscillation(t, y, kind: str, law: AmplitudeLaw = LINEAR, *, excess_prior
     tau = t - t[0]
     rec = _Record(tau, y, kind, ~stuck(y), float(np.median(np.diff(tau))))
     rejected = Rejected(stuck=int((~rec.usable).sum()))
-    omega = _rough_frequency(rec)
+    rec.omega = omega = _rough_frequency(rec)
     if omega * tau[-1] / (2.0 * math.pi) < MIN_CYCLES:
         raise ValueError(f"the record holds {omega * tau[-1] / (2.0 * math.pi):.3g} cycles; at least {MIN_CYCLES} "
                          "are needed")
@@ -316,17 +318,11 @@ def _rough_frequency(rec: _Record) -> float:
 
 def _pass(rec: _Record, baseline: np.ndarray, local, second) -> _Cycles:
     """One pass over the record: windows one local period long, centred a local period apart from the
-    first sample, fitted (:func:`_cycles`) with the local frequency and decay rate ``local(times)``
+    first sample (:func:`.bounds.window_centres`: never more than the record's band allows), fitted
+    (:func:`_cycles`) with the local frequency and decay rate ``local(times)``
     gives, glitches rejected and refitted, bad cycles marked."""
     y = rec.y - baseline - (second.signal(rec.tau) if second is not None else 0.0)
-    centres = [math.pi / float(local(np.array([0.0]))[0][0])]  # the first window starts at the first sample
-    while True:  # the next centre one local period on
-        w = float(local(np.array([centres[-1]]))[0][0])
-        nxt = centres[-1] + 2.0 * math.pi / w
-        if nxt + 0.5 * math.pi / w > rec.tau[-1]:  # a window needs three quarters of its cycle
-            break
-        centres.append(nxt)
-    centres = np.array(centres)
+    centres = window_centres(float(rec.tau[-1]), rec.omega, local)
     omegas, decays = local(centres)
     step = 0.25 * float(np.min(2.0 * math.pi / omegas))
     chirps = (local(centres + step)[0] - local(centres - step)[0]) / (2.0 * step)

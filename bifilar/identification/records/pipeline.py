@@ -30,6 +30,7 @@ from scipy.stats import chi2
 from bifilar.identification.identify import Pencil, invert_period, pencil
 from bifilar.rig import Rig, RigError
 
+from .bounds import LawBandError
 from .fit import OscillationFit, SwingError, fit_oscillation
 from .law import EXCESS_PRIOR, AmplitudeLaw, law_for
 from .read import Record, read_record
@@ -129,6 +130,8 @@ def _fit(record: Record, law: AmplitudeLaw, options: RecordOptions) -> Oscillati
                                scale=options.amplitude_scale, max_amplitude=options.max_amplitude)
     except SwingError as exc:
         raise RigError(record.source, record.column, swing_problem(record, exc.swing, law, options)) from None
+    except LawBandError as exc:
+        raise RigError(record.source, record.column, band_problem(record, exc, options)) from None
     except ValueError as exc:  # a record the fit cannot use
         raise RigError(record.source, record.column, str(exc)) from None
 
@@ -163,6 +166,18 @@ def swing_problem(record: Record, swing: float, law: AmplitudeLaw, options: Reco
         unit = "deg/s" if record.kind == "rate" else "degrees"
         return text + f": are the values in {unit} (--angle-unit deg)?"
     return text + f": check --column and --kind (this is column {record.column!r} read as {record.kind})"
+
+
+def band_problem(record: Record, exc: LawBandError, options: RecordOptions) -> str:
+    """What is wrong with a record whose fitted law leaves its own frequency band (:mod:`.bounds`):
+    an angle past pi / 2 read in rad is likely in degrees; otherwise the time unit is the likely mistake
+    (seconds read as ms put lam omega^2 a million times a real rig's), or the column."""
+    swing = float(np.max(np.abs(record.y - np.median(record.y)))) if record.kind == "angle" else 0.0
+    if options.angle_unit == "rad" and swing > SUSPECT_TORSION:
+        return f"{exc}; the angle reaches {swing:.3g} rad: are the values in degrees (--angle-unit deg)?"
+    other = "s" if options.time_unit == "ms" else "ms"
+    return (f"{exc}; no rig's law does that: is the time column in {other} (--time-unit {other}), or the "
+            f"column {record.column!r} not the {record.kind}?")
 
 
 def halves(record: Record, law: AmplitudeLaw, options: RecordOptions) -> Halves | None:
