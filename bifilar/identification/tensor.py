@@ -42,6 +42,8 @@ from scipy.linalg import eigh
 
 from bifilar.motion.modes import NEUTRAL_RTOL, linearize
 from bifilar.rig import Rig, RigError
+from bifilar.rig.heavy import has_wire_mass
+from bifilar.rig.statics import rest_pose
 
 COMPONENTS = ("I_xx", "I_yy", "I_zz", "I_xy", "I_yz", "I_xz")
 _PAIRS = ((0, 0), (1, 1), (2, 2), (0, 1), (1, 2), (0, 2))
@@ -120,26 +122,35 @@ def components_of(t: np.ndarray) -> np.ndarray:
 _LINEARISED: dict[int, tuple[weakref.ref, object]] = {}
 
 
-def _linearised(rig: Rig):
+def _linearised(rig: Rig, guess=None):
     """:func:`linearize` of ``rig``, once per rig object (its entry goes with the object): a Monte Carlo
     over the periods, or a tare's draws, refits the same hangings' rigs many times, and a trifilar's
-    rest pose alone takes 14 starts (the tensor-tare case: 1475 rest poses, 362 of its 367 s)."""
+    rest pose alone takes 14 starts (the tensor-tare case: 1475 rest poses, 362 of its 367 s). With
+    ``guess`` (the rest pose of a nearby rig) the rest pose is continued from it (:func:`rest_pose`)."""
     hit = _LINEARISED.get(id(rig))
     if hit is not None and hit[0]() is rig:
         return hit[1]
-    lin = linearize(rig)
+    lin = linearize(rig, None if guess is None or has_wire_mass(rig) else rest_pose(rig, guess))
     _LINEARISED[id(rig)] = (weakref.ref(rig, lambda _, key=id(rig): _LINEARISED.pop(key, None)), lin)
     return lin
 
 
 class Linear:
     """One hanging linearised once: its yaw period, d T / d components and d T / d (held moment
-    about a rig axis) at any object tensor."""
+    about a rig axis) at any object tensor.
 
-    def __init__(self, hanging: Hanging):
-        rig, q = hanging.rig, np.asarray(hanging.orientation, float)
-        lin = _linearised(rig)
-        self.label = hanging.label
+    ``like``: a rig that differs from the hanging's in its body's inertia alone, whose linearisation
+    (rest pose and all) is used: the rest pose and the stiffness do not depend on the inertia, and the
+    mass matrix depends on it linearly (its part is taken out below), so hangings that differ only by
+    the object's turn about its COM share one rest-pose search (:func:`bifilar.identification.plan.candidates`).
+    ``guess``: a nearby rig's rest pose to continue from (:func:`_linearised`); ``rest``: the pose found.
+    """
+
+    def __init__(self, hanging: Hanging, like: Rig | None = None, guess=None):
+        q = np.asarray(hanging.orientation, float)
+        rig = hanging.rig if like is None else like
+        lin = _linearised(rig, guess)
+        self.label, self.rest = hanging.label, lin.rest
         self.k = lin.stiffness
         self.body = lin.partial_omega.T @ lin.rest.rotation  # (n x 3): rig-body angular velocity, transposed
         self.arm = self.body @ q  # (n x 3): object-frame angular velocity per speed, transposed

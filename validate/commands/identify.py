@@ -5,7 +5,7 @@
         [--time-unit s|ms] [--angle-unit rad|deg] [--from S] [--to S] [--law-sigma F]
         [--amplitude-scale K | --max-amplitude A]
         [--tare FIXTURE.toml (--tare-period T | --tare-signal FILE ...)]
-        [--samples N] [--json] [--png FILE.png] [--html FILE.html]
+        [--samples N] [--max-seconds S] [--json] [--png FILE.png] [--html FILE.html]
 
 The rig file gives the geometry, the mass and the other inertia entries; the moment being identified
 may be ``nan`` there (or any positive start value): the file's value is not checked, the identified
@@ -23,6 +23,9 @@ propagated (docs/identification.md); without it nothing of the rig is propagated
   records); the object's own moment about the axis through its own COM follows by difference and
   the parallel-axis theorem.
 
+A dense record is fitted in bins (a note says so; :mod:`bifilar.identification.records.bounds`), and the
+records' fits stop with exit 4 once ``--max-seconds`` of wall time are spent, as ``simulate``'s run does.
+
 Exit status 2 with one line for bad input; implausible results are flagged (text and JSON ``flags``).
 JSON fields: docs/identification.md. With an ``[air]`` table the moment is the apparent one (body and
 air) and ``inertia_without_air``, ``inertia_without_air_std`` and ``air_share`` are added
@@ -38,6 +41,7 @@ import numpy as np
 
 from bifilar.rig import RigError, load_rig
 
+from bifilar.identification.records.bounds import SAMPLES_PER_CYCLE, WorkSpent
 from bifilar.identification.records.law import EXCESS_PRIOR
 
 from ..argtypes import UsageError, bounded_float, positive_float, whole_number
@@ -86,6 +90,10 @@ def add_parser(subparsers) -> None:
     tare.add_argument("--tare-signal", metavar="FILE", action="append", help="a record of the fixture alone")
     p.add_argument("--samples", type=whole_number("--samples", 100),
                    help="Monte Carlo draws instead of linear propagation, at least 100 (default: none, linear propagation)")
+    p.add_argument("--max-seconds", type=positive_float("--max-seconds"), default=600.0,
+                   help="wall-time budget of the records' fits, s; they stop with exit 4 when it is spent "
+                        "(default: 600). A dense record is fitted in bins leaving at least 200 samples a cycle "
+                        "(a note says so): its time grows with the rows read, not faster")
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.add_argument("--png", metavar="FILE.png", help="draw each record, its fit, residuals and period against amplitude")
     p.add_argument("--html", metavar="FILE.html", help="write one self-contained page: the result, the fits, the "
@@ -95,12 +103,18 @@ def add_parser(subparsers) -> None:
 def run(args) -> int:
     """Identify, propagate, check and print; returns the exit status (errors raised for cli.main)."""
     _check_options(args)
-    report, trials = _identify(args.rig, args, args.period, args.signal)
-    if args.tare:
-        fixture, tare_trials = _identify(args.tare, args, args.tare_period, args.tare_signal, amplitude=None)
-        report["tare"] = fixture
-        report["object"] = _transfer(args, report, fixture)
-        trials = trials + tare_trials
+    try:
+        report, trials = _identify(args.rig, args, args.period, args.signal)
+        if args.tare:
+            fixture, tare_trials = _identify(args.tare, args, args.tare_period, args.tare_signal, amplitude=None)
+            report["tare"] = fixture
+            report["object"] = _transfer(args, report, fixture)
+            trials = trials + tare_trials
+    except WorkSpent as exc:
+        from ..cli import RunFailed
+
+        raise RunFailed(f"{exc} (--max-seconds {args.max_seconds:g}): give more, or a shorter record "
+                        "(--from, --to)") from None
     if args.png and trials:
         from .identify_png import draw
 
@@ -302,7 +316,7 @@ def _record_options(args):
 
     return RecordOptions(args.column, args.kind, args.time_column, args.fps, args.time_unit, args.angle_unit,
                          args.start, args.end, EXCESS_PRIOR if args.law_sigma is None else args.law_sigma,
-                         args.amplitude_scale, args.max_amplitude)
+                         args.amplitude_scale, args.max_amplitude, args.max_seconds)
 
 
 def _trial(tr, mass: float) -> dict:
@@ -335,6 +349,7 @@ def _trial(tr, mass: float) -> dict:
         "outliers": fit.outliers.tolist(),
         "second_mode": None if fit.second_mode is None else dict(zip(("period", "amplitude", "decay"), fit.second_mode)),
         "samples": fit.samples,
+        "binned": fit.binned,
         "cycles": fit.cycles,
         "dropped": tr.record.dropped,
         "unfolded": tr.record.unfolded,
@@ -462,6 +477,9 @@ def _print_trial(i: int, tr: dict) -> None:
         _say(f"amplitude law: {law['kind']}, ideal {law['ideal']:.4g} A^2, the record's {law['coefficient']:.4g} "
              f"A^2 (excess {100.0 * rel:+.1f} +- {100.0 * rel_std:.1f} %, {100.0 * law['learned']:.0f} % learned from "
              "the record, the rest prior)", 4)
+    if tr["binned"] > 1:
+        _say(f"a dense record: fitted in bins of {tr['binned']} samples ({tr['samples']} bins, at least "
+             f"{SAMPLES_PER_CYCLE} a cycle)", 4)
     h = tr["halves"]
     if h is not None:
         _say(f"halves: T0 {h['first']['period']:.9g} +- {h['first']['period_std']:.2g} s and "

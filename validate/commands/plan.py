@@ -8,7 +8,7 @@ The candidates file (docs/identification.md, section 8):
   and the expected ``inertia``: a finite tensor, the plan's linearisation point);
 * ``fixture`` (optional): a platform the object is mounted on, its COM on the fixture's COM;
 * ``period_std`` (s; default the rig's ``[uncertainty].period``): every period's sigma;
-* ``generate = N`` (optional): N orientations with vertical object axes spread over a hemisphere;
+* ``generate = N`` (optional, 1 .. 5000, seconds): N orientations with vertical object axes spread over a hemisphere;
 * ``[[candidate]]`` tables (optional, with or instead of ``generate``): ``orientation`` (object axes ->
   rig body axes, a rotation vector in rad or a 3x3 matrix) and an optional ``name``.
 
@@ -30,7 +30,9 @@ from bifilar.identification.tensor import COMPONENTS
 from ..argtypes import whole_number
 from ..statuses import epilog
 
-MAX_GENERATED = 5000  # orientations; more adds nothing a few hundred do not, and costs minutes
+# orientations; more adds nothing a few hundred do not. 5000 take ~3 s (~8 s with the object's COM off its
+# origin): bifilar.identification.plan shares the rest poses and batches the designs
+MAX_GENERATED = 5000
 
 
 def add_parser(subparsers) -> None:
@@ -39,8 +41,8 @@ def add_parser(subparsers) -> None:
 
     p = subparsers.add_parser("plan", help="choose the hangings that determine an object's tensor best",
                               epilog=epilog("plan", ("python -m validate plan candidates.toml --count 7",)))
-    p.add_argument("candidates", help="candidates file (TOML): rig, period_std, generate and/or [[candidate]] "
-                                      "tables (docs/identification.md section 8)")
+    p.add_argument("candidates", help=f"candidates file (TOML): rig, period_std, generate (at most {MAX_GENERATED}: "
+                                      "seconds) and/or [[candidate]] tables (docs/identification.md section 8)")
     p.add_argument("--count", required=True, type=whole_number("--count", 6, 100), metavar="K",
                    help="hangings to choose, 6-100")
     p.add_argument("--criterion", choices=CRITERIA, default="worst",

@@ -30,6 +30,7 @@ from scipy.stats import chi2
 from bifilar.identification.identify import Pencil, invert_period, pencil
 from bifilar.rig import Rig, RigError
 
+from .bounds import Deadline, LawBandError, WorkSpent
 from .fit import OscillationFit, SwingError, fit_oscillation
 from .law import EXCESS_PRIOR, AmplitudeLaw, law_for
 from .read import Record, read_record
@@ -45,7 +46,7 @@ class RecordOptions:
     """How to read and fit the records (identify's record options; units as :mod:`.read` says).
     ``law_sigma``: the prior std of the real law's excess relative to the ideal coefficient;
     ``amplitude_scale`` (signal units per rad) and ``max_amplitude`` (rad): what is known of a
-    proportional record's scale."""
+    proportional record's scale; ``max_seconds``: the fits' wall-time budget, s."""
 
     column: str | None = None
     kind: str = "angle"
@@ -58,6 +59,7 @@ class RecordOptions:
     law_sigma: float = EXCESS_PRIOR
     amplitude_scale: float | None = None
     max_amplitude: float | None = None
+    max_seconds: float | None = None  # wall-time budget of all the records' fits (None: unbounded)
 
 
 @dataclass(frozen=True)
@@ -103,32 +105,44 @@ def identify_records(rig: Rig, axis, paths: list, options: RecordOptions = Recor
                      p: Pencil | None = None) -> tuple[list[Trial], Pooled]:
     """The module's loop over ``paths`` (record files, or :class:`.read.Record` objects already read) of
     one rig: the trials and their pool. ``p``: the rig's pencil about ``axis`` (its rest pose), if
-    known. Raises :class:`RigError` naming the file and column of a record that cannot be used."""
+    known. Raises :class:`RigError` naming the file and column of a record that cannot be used,
+    :class:`.bounds.WorkSpent` naming the file once ``options.max_seconds`` is spent."""
     p = pencil(rig, axis) if p is None else p
     ideal = law_for(rig, axis, rest=p.lin.rest)
+    deadline = Deadline(options.max_seconds)
     trials = []
     for path in paths:
         record = path if isinstance(path, Record) else read_record(
             path, options.column, options.kind, time_column=options.time_column, fps=options.fps,
             time_unit=options.time_unit, angle_unit=options.angle_unit, start=options.start, end=options.end)
-        fit = _fit(record, ideal, options)
-        law = _law_at(rig, axis, fit, ideal, p)
-        if not law.same_as(ideal):
-            fit = _fit(record, law, options)
-        found = _invert(rig, axis, fit, record, p)
-        split = halves(record, law, options)
-        std = found.moment * fit.period_std / fit.period / found.sensitivity
-        trials.append(Trial(record, fit, split, found.moment, std, found.sensitivity,
-                            tuple(_flags(record, fit, split, options))))
+        try:
+            trials.append(_trial(rig, axis, record, ideal, options, p, deadline))
+        except WorkSpent as exc:
+            raise WorkSpent(f"{record.source}: {record.column}: {exc}") from None
     return trials, pool(trials)
 
 
-def _fit(record: Record, law: AmplitudeLaw, options: RecordOptions) -> OscillationFit:
+def _trial(rig: Rig, axis, record: Record, ideal: AmplitudeLaw, options: RecordOptions, p: Pencil,
+           deadline: Deadline) -> Trial:
+    """Steps 2-6 of the module docstring for one record."""
+    fit = _fit(record, ideal, options, deadline)
+    law = _law_at(rig, axis, fit, ideal, p)
+    if not law.same_as(ideal):
+        fit = _fit(record, law, options, deadline)
+    found = _invert(rig, axis, fit, record, p)
+    split = halves(record, law, options, deadline)
+    std = found.moment * fit.period_std / fit.period / found.sensitivity
+    return Trial(record, fit, split, found.moment, std, found.sensitivity, tuple(_flags(record, fit, split, options)))
+
+
+def _fit(record: Record, law: AmplitudeLaw, options: RecordOptions, deadline: Deadline | None = None) -> OscillationFit:
     try:
         return fit_oscillation(record.t, record.y, record.kind, law, excess_prior=options.law_sigma,
-                               scale=options.amplitude_scale, max_amplitude=options.max_amplitude)
+                               scale=options.amplitude_scale, max_amplitude=options.max_amplitude, deadline=deadline)
     except SwingError as exc:
         raise RigError(record.source, record.column, swing_problem(record, exc.swing, law, options)) from None
+    except LawBandError as exc:
+        raise RigError(record.source, record.column, band_problem(record, exc, options)) from None
     except ValueError as exc:  # a record the fit cannot use
         raise RigError(record.source, record.column, str(exc)) from None
 
@@ -165,7 +179,20 @@ def swing_problem(record: Record, swing: float, law: AmplitudeLaw, options: Reco
     return text + f": check --column and --kind (this is column {record.column!r} read as {record.kind})"
 
 
-def halves(record: Record, law: AmplitudeLaw, options: RecordOptions) -> Halves | None:
+def band_problem(record: Record, exc: LawBandError, options: RecordOptions) -> str:
+    """What is wrong with a record whose fitted law leaves its own frequency band (:mod:`.bounds`):
+    an angle past pi / 2 read in rad is likely in degrees; otherwise the time unit is the likely mistake
+    (seconds read as ms put lam omega^2 a million times a real rig's), or the column."""
+    swing = float(np.max(np.abs(record.y - np.median(record.y)))) if record.kind == "angle" else 0.0
+    if options.angle_unit == "rad" and swing > SUSPECT_TORSION:
+        return f"{exc}; the angle reaches {swing:.3g} rad: are the values in degrees (--angle-unit deg)?"
+    other = "s" if options.time_unit == "ms" else "ms"
+    return (f"{exc}; no rig's law does that: is the time column in {other} (--time-unit {other}), or the "
+            f"column {record.column!r} not the {record.kind}?")
+
+
+def halves(record: Record, law: AmplitudeLaw, options: RecordOptions,
+           deadline: Deadline | None = None) -> Halves | None:
     """Step 6: the record cut at the middle of its time span, each half fitted alone; None if a half
     cannot be fitted (too few cycles)."""
     t = record.t
@@ -174,7 +201,8 @@ def halves(record: Record, law: AmplitudeLaw, options: RecordOptions) -> Halves 
     for part in (t < split, t >= split):
         try:
             fits.append(fit_oscillation(t[part], record.y[part], record.kind, law, excess_prior=options.law_sigma,
-                                        scale=options.amplitude_scale, max_amplitude=options.max_amplitude))
+                                        scale=options.amplitude_scale, max_amplitude=options.max_amplitude,
+                                        deadline=deadline))
         except ValueError:
             return None
     a, b = fits
