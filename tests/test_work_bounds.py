@@ -56,6 +56,7 @@ def test_a_record_in_the_wrong_unit_is_refused_in_one_line(tmp_path, amplitude, 
     assert likely in out.stderr and "Traceback" not in out.stderr
 
 
+@pytest.mark.slow
 def test_a_dense_record_gives_the_moment_in_bins_in_seconds():
     """Item 2: a 2500 Hz record (30 cycles, 1.5e5 rows). Its frequency was taken from a stride of its
     noisy derivative (the full rate's noise, 1e-3 rad at 2500 Hz, drowns the swing's derivative): the
@@ -82,6 +83,7 @@ def test_identify_honours_max_seconds(tmp_path):
     assert out.stderr.startswith(f"error: {path}: angle: ") and "(--max-seconds 1e-06)" in out.stderr
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("com, generate", [("[0.0, 0.0, 0.0]", 5000), ("[0.01, 0.005, 0.02]", 1000)])
 def test_plan_with_the_most_generated_candidates_ends_in_seconds(tmp_path, com, generate):
     """Item 3: every candidate had its own rest-pose search (a trifilar's: 14 starts, ~0.1 s), and the
