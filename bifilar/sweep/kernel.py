@@ -21,6 +21,7 @@ import numba as nb
 import numpy as np
 
 from bifilar.motion import nwire_kernel as NK
+from bifilar.motion.modes import resolution  # the neutral and degenerate tests of linearize
 from bifilar.rig import pose_kernel as PK
 from bifilar.rig.statics import NEWTON_ITERATIONS, RESIDUAL  # the same Newton as rest_pose
 
@@ -53,10 +54,11 @@ def continued_modes(arms, anchors, lengths, mass, gravity, inertia, scale, com, 
     big = max(np.abs(w2).max(), 1e-300)
     if w2[0] < -slack_rtol * big:
         return UNSTABLE, com, rot, tensions, w2, np.zeros((6, 0))
-    if w2[0] <= neutral_rtol * big:
+    if w2[0] <= resolution(gravity / scale, big, neutral_rtol):
         return NEUTRAL, com, rot, tensions, w2, np.zeros((6, 0))
+    gap = resolution(gravity / scale, big, degenerate_rtol)
     for k in range(n - 1):
-        if w2[k + 1] - w2[k] <= degenerate_rtol * big:
+        if w2[k + 1] - w2[k] <= gap:
             return DEGENERATE, com, rot, tensions, w2, np.zeros((6, 0))
     return OK, com, rot, tensions, w2, z @ (chol_inv.T @ y)
 
