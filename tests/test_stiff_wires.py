@@ -3,6 +3,7 @@ wires of E A = 1e10 N (inside the field's range), a sweep over ``axial_stiffness
 wires, and ``tensor`` on an elastic platform from a rough start."""
 
 import json
+import re
 
 import pytest
 
@@ -41,3 +42,41 @@ def test_stiff_wires_keep_their_slow_modes_and_identify(tmp_path, capsys):
         assert periods[motion] == pytest.approx(soft[motion], rel=1e-6)
     found = _json(capsys, "identify", str(path), "--axis", "z", "--period", repr(periods["yaw"]))
     assert found["inertia"] == pytest.approx(0.24, rel=1e-6)
+
+
+def _sweep_space(tmp_path, rig_text: str, vary: str, axes: str = '["z"]'):
+    (tmp_path / "rig.toml").write_text(rig_text)
+    (tmp_path / "space.toml").write_text(f'rig = "rig.toml"\n[vary]\n{vary}\n[measure]\naxes = {axes}\namplitude = 0.05\n')
+    return tmp_path / "space.toml"
+
+
+def test_a_sweep_over_stiffness_hangs_what_modes_hangs(tmp_path):
+    # Item 5: the sweep's peak tension came from the inextensible wires' tensions, (J M^-1 J^T)^-1 ..., singular
+    # on four parallel wires: every row "singular", at any E A. Now the elastic law (see sweep.kernel.peak_tension).
+    from bifilar.sweep.evaluate import evaluate
+    from bifilar.sweep.space import load_space
+
+    space = load_space(_sweep_space(tmp_path, QUAD, "axial_stiffness = [1e6, 1e10]"))
+    guess = None
+    for values in space.points():
+        row = evaluate(space, values, guess)
+        assert row.feasible, row.reason
+        assert row.periods[:3] == pytest.approx((2.45692, 2.45692, 2.00607), abs=2e-5)
+        # A 0.05 rad yaw lifts the plate by R^2 A^2 / (2 L) and pulls each wire by about m (R A omega)^2 / (4 L) more.
+        assert 9.81 < row.tension_peak < 9.81 * 1.01
+        guess = row.rest
+
+
+def test_stiff_wires_of_unequal_length_settle(tmp_path, capsys):
+    # Item 5: the elastic rest pose's trust region shrank onto the kink of a wire slack on one side of a valley
+    # ~W / sum k wide (4e-9 m at E A = 1e10 N): "no stable rest pose" for a rig that hangs taut at 1e6 N.
+    text = (RIGS / "quadrifilar_asymmetric.toml").read_text()
+    path = tmp_path / "asym.toml"
+
+
+    path.write_text(re.sub(r"axial_stiffness = [0-9.e]+", "axial_stiffness = 1e10", text))
+    lin = _json(capsys, "modes", str(path))
+    assert min(lin["equilibrium"]["tensions"]) > 0.0
+    periods = {m["motion"]: m["period"] for m in lin["modes"]}
+    assert periods["sway x"] == pytest.approx(2.61484, abs=1e-4) and periods["sway y"] == pytest.approx(2.21191, abs=1e-4)
+

@@ -64,16 +64,27 @@ def continued_modes(arms, anchors, lengths, mass, gravity, inertia, scale, com, 
 
 
 @nb.njit(cache=True)
-def peak_tension(com, rot, shapes, omegas, arms, anchors, inertia, mass, gravity, air):
+def peak_tension(com, rot, shapes, omegas, springs, base, arms, anchors, inertia, mass, gravity, air):
     """Largest tension (N) over the modes ``shapes[k]`` (x, theta; world) of angular frequency
     ``omegas[k]`` (rad/s) and over their states: at rest with velocity omega * shape, and at rest
-    displaced by +-shape without velocity."""
+    displaced by +-shape without velocity.
+
+    Elastic wires (``springs``, N/m; empty: inextensible; ``base``: the rest tensions, N): at the displaced
+    states the elastic law to first order, base +- K J shape (exact for the fast modes, whose tension is
+    their stretch, and the slow ones alike); at the moving state
+    :func:`~bifilar.motion.nwire_kernel.compatible_tensions` (the centripetal part). The inextensible
+    tensions are singular on four parallel wires (statically indeterminate; issue 35 item 5)."""
     y = np.zeros(NK.STATE_SIZE)
     peak = -np.inf
     for k in range(shapes.shape[0]):
         y[:3] = com
         y[3:7] = NK.matrix_quat(rot)
         y[7:13] = omegas[k] * shapes[k]
+        if springs.size:
+            peak = max(peak, NK.compatible_tensions(y, arms, anchors, inertia, mass, gravity, air, springs, base).max())
+            stretch = springs * np.abs(NK.dynamics_jacobian(y, arms, anchors) @ shapes[k])
+            peak = max(peak, (base + stretch).max())
+            continue
         peak = max(peak, NK.tensions(y, arms, anchors, inertia, mass, gravity, air).max())
         for sign in (1.0, -1.0):
             y[:3] = com + sign * shapes[k, :3]
