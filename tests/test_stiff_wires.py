@@ -80,3 +80,18 @@ def test_stiff_wires_of_unequal_length_settle(tmp_path, capsys):
     periods = {m["motion"]: m["period"] for m in lin["modes"]}
     assert periods["sway x"] == pytest.approx(2.61484, abs=1e-4) and periods["sway y"] == pytest.approx(2.21191, abs=1e-4)
 
+
+@pytest.mark.parametrize("vary", ["[vary]\naxial_stiffness = [1e5, 1e6]", "[[point]]\naxial_stiffness = 1e5"])
+def test_an_elastic_axis_on_heavy_wires_is_refused(tmp_path, capsys, vary):
+    # Item 6: the sweep held each axis's values to the rig file's ranges only, not to its rule that heavy wires
+    # are inextensible: the rows were evaluated on a model the rig file refuses.
+    heavy = (RIGS / "parallel.toml").read_text().replace("length = 1.5\n", "length = 1.5\nlinear_density = 0.01\n")
+    (tmp_path / "rig.toml").write_text(heavy)
+    space = tmp_path / "space.toml"
+    space.write_text(f'rig = "rig.toml"\n{vary}\n[measure]\naxes = ["z"]\n')
+    code = main(["sweep", str(space), "--out", str(tmp_path / "out")])
+    out, err = capsys.readouterr()
+    field = "vary.axial_stiffness" if vary.startswith("[vary]") else "point[1].axial_stiffness"
+    assert code == 2 and err.count("\n") == 1, err
+    assert err.startswith(f"error: {space}: {field}: ") and "linear_density" in err and "inextensible" in err, err
+    assert not (tmp_path / "out" / "sweep.csv").exists()
