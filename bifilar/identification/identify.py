@@ -44,7 +44,7 @@ from scipy.linalg import eigh
 from scipy.spatial.transform import Rotation
 
 from bifilar.motion.kane import KaneModel
-from bifilar.motion.modes import NEUTRAL_RTOL, Modes, degenerate_sets, linearize
+from bifilar.motion.modes import Modes, degenerate_sets, linearize, oscillating
 from bifilar.identification.periods import period as crossing_period
 from bifilar.rig import Rig, RigError
 from bifilar.motion.nwire import NWireModel
@@ -119,9 +119,9 @@ class Pencil:
         all of the set's share about the axis and the others none (eigh's own basis would mix them,
         and the association and the sensitivity with them)."""
         w2, v = eigh(self.lin.stiffness, self.mass(value))
-        keep = w2 > NEUTRAL_RTOL * max(abs(w2).max(), 1e-300)
+        keep = oscillating(w2, self.lin.pendulum)
         w2, v = w2[keep], v[:, keep]
-        for k, j in degenerate_sets(w2):
+        for k, j in degenerate_sets(w2, self.lin.pendulum):
             c = self.w @ v[:, k:j]
             if c @ c > 0.0:
                 # an orthogonal transform of the set whose first column is c / |c| (Householder)

@@ -40,7 +40,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.linalg import eigh
 
-from bifilar.motion.modes import NEUTRAL_RTOL, linearize
+from bifilar.motion.modes import linearize, oscillating
 from bifilar.rig import Rig, RigError
 from bifilar.rig.heavy import has_wire_mass
 from bifilar.rig.statics import rest_pose
@@ -156,12 +156,13 @@ class Linear:
         self.arm = self.body @ q  # (n x 3): object-frame angular velocity per speed, transposed
         self.m_held = lin.mass - self.body @ (rig.inertia - np.asarray(hanging.held, float)) @ self.body.T
         self.vertical = lin.partial_omega.T @ np.array([0.0, 0.0, 1.0])
+        self.pendulum = lin.pendulum
 
     def solve(self, x: np.ndarray):
         """(T, v, index) of the yaw at components ``x``: v the M-normalised shapes of the oscillating
         modes; raises RigError when another mode turns about the vertical nearly as much."""
         w2, v = eigh(self.k, self.m_held + self.arm @ tensor_of(x) @ self.arm.T)
-        keep = w2 > NEUTRAL_RTOL * max(abs(w2).max(), 1e-300)
+        keep = oscillating(w2, self.pendulum)
         w2, v = w2[keep], v[:, keep]
         share = (self.vertical @ v) ** 2
         order = np.argsort(share)[::-1]

@@ -31,6 +31,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+import numba as nb
 import numpy as np
 from scipy.linalg import eigh
 
@@ -40,8 +41,12 @@ from bifilar.rig import elastic, heavy
 from bifilar.rig.heavy import has_wire_mass
 from bifilar.rig.statics import NULL_RTOL, PK, Rest, State, anchors, arms, rest_pose, rig_scale
 
-NEUTRAL_RTOL = 1e-9  # an eigenvalue below this fraction of the largest is neutral (or unstable)
-DEGENERATE_RTOL = 1e-9  # eigenvalues closer than this fraction of the largest are one frequency
+# An omega^2 below this fraction of the pendulum's scale g / S (S: rig_scale) is neutral (or unstable), and
+# two closer than it are one frequency; or below the eigen-solver's round-off, ROUNDOFF_RTOL of the
+# largest |omega^2|, where that is larger (see resolution).
+NEUTRAL_RTOL = 1e-9
+DEGENERATE_RTOL = 1e-9
+ROUNDOFF_RTOL = 1e-12
 MOTIONS = ("sway x", "sway y", "yaw", "tilt")
 ELASTIC_MOTIONS = ("sway x", "sway y", "yaw", "bounce", "roll", "pitch")  # elastic wires: six modes
 # Pose directions (x, theta) tried in this order to resolve a degenerate eigenspace.
@@ -74,6 +79,7 @@ class Modes:
     mass: np.ndarray  # M (n x n)
     stiffness: np.ndarray  # K (n x n)
     basis: np.ndarray  # Z (6 x n): pose displacement (x, theta; world) per independent coordinate
+    pendulum: float  # g / S (rad^2/s^2, S: rig_scale): the scale of the slow modes' omega^2 (see resolution)
 
     @property
     def partial_com(self) -> np.ndarray:
@@ -84,6 +90,27 @@ class Modes:
     def partial_omega(self) -> np.ndarray:
         """Angular velocity (world, 3 x n) per independent speed."""
         return self.basis[3:]
+
+
+def pendulum_scale(rig: Rig) -> float:
+    """g / S (rad^2/s^2), S the rig's longest wire or anchor span: the scale of a pendulum's omega^2."""
+    return rig.gravity / rig_scale(rig)
+
+
+@nb.njit(cache=True)
+def resolution(pendulum: float, big: float, rtol: float) -> float:
+    """The omega^2 (rad^2/s^2) at or below which a mode is neutral, and the gap within which two are one
+    frequency: ``rtol`` of the ``pendulum`` scale g / S, or the eigen-solver's round-off on the largest
+    |omega^2| ``big`` (:data:`ROUNDOFF_RTOL`) if that is larger. Not a fraction of the largest alone: stiff
+    elastic wires put the bounce's omega^2 (~EA / (m L)) 1e9 times above the sways' g / L at EA = 1e10
+    (issue 35 item 4), where a fraction of it would call the sways and the yaw neutral (and one frequency)."""
+    return max(rtol * pendulum, ROUNDOFF_RTOL * big, 1e-300)
+
+
+def oscillating(w2: np.ndarray, pendulum: float) -> np.ndarray:
+    """Which of the eigenvalues ``w2`` are oscillating modes (not neutral or unstable; :func:`resolution`)."""
+    big = float(np.abs(w2).max()) if len(w2) else 0.0
+    return w2 > resolution(pendulum, big, NEUTRAL_RTOL)
 
 
 def reduced(rig: Rig, rest: Rest) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -136,14 +163,14 @@ def motion_of(rig: Rig, rest: Rest, com: np.ndarray, rotation: np.ndarray) -> st
     return max(MOTIONS, key=energy.__getitem__)
 
 
-def degenerate_sets(w2: np.ndarray) -> list[tuple[int, int]]:
+def degenerate_sets(w2: np.ndarray, pendulum: float) -> list[tuple[int, int]]:
     """(start, stop) of each run of two or more ascending eigenvalues ``w2`` that are one frequency:
-    within :data:`DEGENERATE_RTOL` of the largest |w2| of each other."""
-    scale = max(abs(w2).max(), 1e-300) if len(w2) else 1.0
+    within :func:`resolution` (``pendulum``: g / S) of each other."""
+    gap = resolution(pendulum, float(np.abs(w2).max()) if len(w2) else 0.0, DEGENERATE_RTOL)
     sets, k = [], 0
     while k < len(w2):
         j = k + 1
-        while j < len(w2) and w2[j] - w2[k] <= DEGENERATE_RTOL * scale:
+        while j < len(w2) and w2[j] - w2[k] <= gap:
             j += 1
         if j - k > 1:
             sets.append((k, j))
@@ -151,11 +178,11 @@ def degenerate_sets(w2: np.ndarray) -> list[tuple[int, int]]:
     return sets
 
 
-def _resolve_degenerate(w2: np.ndarray, vecs: np.ndarray, z: np.ndarray, m6: np.ndarray) -> np.ndarray:
+def _resolve_degenerate(w2: np.ndarray, vecs: np.ndarray, z: np.ndarray, m6: np.ndarray, pendulum: float) -> np.ndarray:
     """Eigenvectors with every degenerate eigenspace spanned along :data:`_PREFERRED` directions
     (M-orthonormal, by Gram-Schmidt), each with its largest pose component positive."""
     vecs = vecs.copy()
-    for k, j in degenerate_sets(w2):
+    for k, j in degenerate_sets(w2, pendulum):
         space = vecs[:, k:j]
         chosen = []
         for direction in _PREFERRED:
@@ -190,22 +217,23 @@ def linearize(rig: Rig, rest: Rest | None = None) -> Modes:
         m6[:3, :3] = rig.mass * np.eye(3)
         m6[3:, 3:] = rest.rotation @ rig.inertia @ rest.rotation.T
         m6 += air_mass_world(rig, rest)
+    pendulum = pendulum_scale(rig)
     if z.shape[1] == 0:
-        return Modes(rest, (), mr, kr, z)
+        return Modes(rest, (), mr, kr, z, pendulum)
     w2, vecs = eigh(kr, mr)
-    vecs = _resolve_degenerate(w2, vecs, z, m6)
+    vecs = _resolve_degenerate(w2, vecs, z, m6, pendulum)
+    moving = oscillating(w2, pendulum)
     scale = max(np.linalg.norm(arms(rig), axis=1).max(), 1e-3)
     modes = []
     for k in range(len(w2)):
         shape = z @ vecs[:, k]
         com, rot = shape[:3], shape[3:]
         norm = max(np.linalg.norm(rot), np.linalg.norm(com) / scale)
-        neutral = w2[k] <= NEUTRAL_RTOL * max(abs(w2).max(), 1e-300)
-        period = None if neutral else float(2.0 * np.pi / np.sqrt(w2[k]))
+        period = float(2.0 * np.pi / np.sqrt(w2[k])) if moving[k] else None
         modes.append(Mode(period, float(w2[k]), com / norm, rot / norm, motion_of(rig, rest, com, rot),
                           _stretch_share(rig, rest, shape)))
     modes.sort(key=lambda m: (m.period is not None, -(m.period or 0.0)))
-    return Modes(rest, tuple(modes), mr, kr, z)
+    return Modes(rest, tuple(modes), mr, kr, z, pendulum)
 
 
 def _stretch_share(rig: Rig, rest: Rest, shape: np.ndarray) -> float:

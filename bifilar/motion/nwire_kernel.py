@@ -75,6 +75,32 @@ def dynamics(y, arms, anchors, inertia_body, mass, gravity, air):
     (:func:`bifilar.motion.kane.air_vector`); with air the fluid's added mass M_A,w joins the mass
     matrix and its velocity terms and drag the applied wrench, exactly as in the Kane model
     (``kane_kernel.air_terms``); in a vacuum the block-diagonal path below runs unchanged."""
+    minv_f, minv_jt, jac, b, rho = _system(y, arms, anchors, inertia_body, mass, gravity, air)
+    tension = np.linalg.solve(jac @ minv_jt, jac @ minv_f - b)
+    acc = minv_f - minv_jt @ tension
+    return acc, tension, jac, rho
+
+
+@njit(cache=True)
+def compatible_tensions(y, arms, anchors, inertia_body, mass, gravity, air, springs, base):
+    """Tensions (N) at state y of wires with spring constants ``springs`` (N/m) whose tensions at a
+    nearby pose are ``base``: t = base + K J d, K = diag(springs), with the pose change d the least-squares
+    solution of (J M^-1 J^T) K J d = J M^-1 f - b - (J M^-1 J^T) base, the equations :func:`dynamics`
+    solves. Where J M^-1 J^T is invertible (two or three wires) this is :func:`dynamics`' tension exactly;
+    where it is singular (four parallel wires: statically indeterminate) the increment is the one the
+    wires' stretch allows, and the self-stress of ``base`` (the part no motion of the body changes to first
+    order) is kept: what :func:`dynamics` cannot solve (issue 35 item 5)."""
+    minv_f, minv_jt, jac, b, _ = _system(y, arms, anchors, inertia_body, mass, gravity, air)
+    a = jac @ minv_jt
+    stretch = jac * springs.reshape(-1, 1)  # K J
+    d = np.linalg.lstsq(a @ stretch, jac @ minv_f - b - a @ base, 1e-10)[0]
+    return base + stretch @ d
+
+
+@njit(cache=True)
+def _system(y, arms, anchors, inertia_body, mass, gravity, air):
+    """(M^-1 f, M^-1 J^T, J, b, rho) at state y: the terms of J M^-1 J^T t = J M^-1 f - b, the wires'
+    tensions t that keep every wire at its length (see :func:`dynamics`)."""
     n = arms.shape[0]
     c, v, om = y[0:3], y[7:10], y[10:13]
     rot = quat_matrix(y[3:7])
@@ -115,9 +141,7 @@ def dynamics(y, arms, anchors, inertia_body, mass, gravity, air):
         for i in range(n):
             minv_jt[:3, i] = jac[i, :3] / mass
             minv_jt[3:, i] = iw_inv @ jac[i, 3:]
-    tension = np.linalg.solve(jac @ minv_jt, jac @ minv_f - b)
-    acc = minv_f - minv_jt @ tension
-    return acc, tension, jac, rho
+    return minv_f, minv_jt, jac, b, rho
 
 
 @njit(cache=True)

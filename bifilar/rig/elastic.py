@@ -22,6 +22,8 @@ determined here by their stiffnesses. Derived in docs/elastic-wires.md.
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 
 from bifilar.rig import Rig, RigError
@@ -35,6 +37,10 @@ ROUNDING = 16.0
 MAX_ITERATIONS = 300
 # A stable rest pose: no eigenvalue of hess V below -this fraction of its largest.
 STABLE_SLACK = 1e-12
+# Wires stiffer than stretching by this fraction of the rig's size under the weight are settled by
+# continuation in their stiffness, from wires this soft up by STIFFENING a step (see settle).
+SOFT_STRETCH = 1e-3
+STIFFENING = 100.0
 
 
 def springs(rig: Rig) -> np.ndarray:
@@ -112,6 +118,30 @@ def minimise(rig: Rig, com: np.ndarray, rotation: np.ndarray, arms: np.ndarray, 
     return com, rotation, tension, False
 
 
+def settle(rig: Rig, com: np.ndarray, rotation: np.ndarray, arms: np.ndarray, anchors: np.ndarray, scale: float,
+           fixed_rotation: bool = False):
+    """:func:`minimise` from a pose (``fixed_rotation``: the COM alone), continued in the wires' stiffness: (com, rotation, tensions, converged).
+
+    Why: V's valley across the wires' directions is ~W / sum k wide, ~1e-9 m at E A = 1e10 N, and a wire
+    slack on one side of it and taut on the other: from a start a visible distance away the trust region
+    shrank onto that kink and stopped (a four-wire platform at E A = 1e10 N: "no stable rest pose", where
+    1e6 N settled; issue 35 item 5). Wires stiffer than stretching by :data:`SOFT_STRETCH` of the rig's
+    size are first settled that soft, then stiffened :data:`STIFFENING` times a step, each step's pose the
+    next one's start (a stretch away from it), up to their own stiffness; softer wires go straight on."""
+    weight = rig.mass * rig.gravity
+    soft = weight / (float(springs(rig).sum()) * SOFT_STRETCH * scale)
+    factors = []
+    while soft < 1.0:
+        factors.append(soft)
+        soft *= STIFFENING
+    for factor in factors:
+        softer = replace(rig, wires=tuple(replace(w, axial_stiffness=w.axial_stiffness * factor) for w in rig.wires))
+        com, rotation, _, ok = minimise(softer, com, rotation, arms, anchors, scale, fixed_rotation)
+        if not ok:
+            break
+    return minimise(rig, com, rotation, arms, anchors, scale, fixed_rotation)
+
+
 def _trust_step(g: np.ndarray, h: np.ndarray, radius: float) -> np.ndarray:
     """The minimiser of g.p + p.h.p / 2 with |p| <= radius (More-Sorensen by bisection on the shift)."""
     lam, vec = np.linalg.eigh(h)
@@ -145,7 +175,7 @@ def rest_pose(rig: Rig, starts, arms: np.ndarray, anchors: np.ndarray, scale: fl
     found = []
     for com, rotation in starts:
         try:
-            c, r, t, ok = minimise(rig, com, rotation, arms, anchors, scale)
+            c, r, t, ok = settle(rig, com, rotation, arms, anchors, scale)
         except np.linalg.LinAlgError:
             continue
         if not ok or not np.all(np.isfinite(c)):

@@ -138,7 +138,6 @@ def rig_from_dict(data: dict, source: str = "<memory>", default_name: str = "rig
         raise RigError(source, "wire", "missing: give the wires as [[wire]] tables")
     if not 2 <= len(wires_raw) <= MAX_WIRES:
         raise RigError(source, "wire", f"2 to {MAX_WIRES} [[wire]] tables needed, found {len(wires_raw)}")
-    _check_heavy_inextensible(wires_raw, source)
     wires = []
     for i, w in enumerate(wires_raw, start=1):
         prefix = f"wire[{i}]."
@@ -154,6 +153,7 @@ def rig_from_dict(data: dict, source: str = "<memory>", default_name: str = "rig
                 if "linear_density" in w else 0.0,
             )
         )
+    check_heavy_inextensible(wires, source)
     given = [w.axial_stiffness is not None for w in wires]
     if any(given) and not all(given):
         first = given.index(not given[0]) + 1
@@ -194,11 +194,12 @@ def rig_from_dict(data: dict, source: str = "<memory>", default_name: str = "rig
     return rig
 
 
-def _check_heavy_inextensible(wires_raw: list[dict], source: str) -> None:
+def check_heavy_inextensible(wires, source: str) -> None:
     """Refuse heavy wires (``linear_density``) on a rig with elastic ones (``axial_stiffness``): the
-    heavy-wire correction (docs/heavy-wires.md) is derived for inextensible wires only."""
-    heavy = [i for i, w in enumerate(wires_raw, start=1) if "linear_density" in w]
-    elastic = [i for i, w in enumerate(wires_raw, start=1) if "axial_stiffness" in w]
+    heavy-wire correction (docs/heavy-wires.md) is derived for inextensible wires only. On the
+    :class:`Wire` objects, so that a sweep's configured rig is held to it as a file is."""
+    heavy = [i for i, w in enumerate(wires, start=1) if w.linear_density > 0.0]
+    elastic = [i for i, w in enumerate(wires, start=1) if w.axial_stiffness is not None]
     if heavy and elastic:
         raise RigError(source, f"wire[{heavy[0]}].linear_density", f"heavy wires are modelled inextensible: not "
                        f"with axial_stiffness (wire[{elastic[0]}]); give one or the other")

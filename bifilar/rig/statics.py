@@ -597,8 +597,8 @@ def _elastic_initial_state(rig: Rig, rest: Rest, rotation: np.ndarray) -> State:
     wire spheres is also the nearest (a turn about the vertical: a pure rise)."""
     from bifilar.rig import elastic
 
-    com, _, _, ok = elastic.minimise(rig, rest.com, rotation, arms(rig), anchors(rig), rig_scale(rig),
-                                     fixed_rotation=True)
+    com, _, _, ok = elastic.settle(rig, rest.com, rotation, arms(rig), anchors(rig), rig_scale(rig),
+                                   fixed_rotation=True)
     if not ok:
         raise RigError(rig.source, "initial.rotation", "the body turned this far finds no rest for its COM on the "
                        "elastic wires")

@@ -93,7 +93,9 @@ def _peak(model: NWireModel, rest: Rest, shapes: list, periods: list, abouts: li
             omegas.append(2.0 * np.pi / period)
     if not scaled:
         return math.nan
-    return float(SK.peak_tension(rest.com, rest.rotation, np.array(scaled), np.array(omegas), *model.args))
+    springs = np.zeros(0) if model.springs is None else model.springs
+    return float(SK.peak_tension(rest.com, rest.rotation, np.array(scaled), np.array(omegas), springs,
+                                 np.asarray(rest.tensions, float), *model.args))
 
 
 def measured_mode(rig: Rig, lin: Modes, about: np.ndarray) -> int:

@@ -21,6 +21,7 @@ import numba as nb
 import numpy as np
 
 from bifilar.motion import nwire_kernel as NK
+from bifilar.motion.modes import resolution  # the neutral and degenerate tests of linearize
 from bifilar.rig import pose_kernel as PK
 from bifilar.rig.statics import NEWTON_ITERATIONS, RESIDUAL  # the same Newton as rest_pose
 
@@ -53,25 +54,37 @@ def continued_modes(arms, anchors, lengths, mass, gravity, inertia, scale, com, 
     big = max(np.abs(w2).max(), 1e-300)
     if w2[0] < -slack_rtol * big:
         return UNSTABLE, com, rot, tensions, w2, np.zeros((6, 0))
-    if w2[0] <= neutral_rtol * big:
+    if w2[0] <= resolution(gravity / scale, big, neutral_rtol):
         return NEUTRAL, com, rot, tensions, w2, np.zeros((6, 0))
+    gap = resolution(gravity / scale, big, degenerate_rtol)
     for k in range(n - 1):
-        if w2[k + 1] - w2[k] <= degenerate_rtol * big:
+        if w2[k + 1] - w2[k] <= gap:
             return DEGENERATE, com, rot, tensions, w2, np.zeros((6, 0))
     return OK, com, rot, tensions, w2, z @ (chol_inv.T @ y)
 
 
 @nb.njit(cache=True)
-def peak_tension(com, rot, shapes, omegas, arms, anchors, inertia, mass, gravity, air):
+def peak_tension(com, rot, shapes, omegas, springs, base, arms, anchors, inertia, mass, gravity, air):
     """Largest tension (N) over the modes ``shapes[k]`` (x, theta; world) of angular frequency
     ``omegas[k]`` (rad/s) and over their states: at rest with velocity omega * shape, and at rest
-    displaced by +-shape without velocity."""
+    displaced by +-shape without velocity.
+
+    Elastic wires (``springs``, N/m; empty: inextensible; ``base``: the rest tensions, N): at the displaced
+    states the elastic law to first order, base +- K J shape (exact for the fast modes, whose tension is
+    their stretch, and the slow ones alike); at the moving state
+    :func:`~bifilar.motion.nwire_kernel.compatible_tensions` (the centripetal part). The inextensible
+    tensions are singular on four parallel wires (statically indeterminate; issue 35 item 5)."""
     y = np.zeros(NK.STATE_SIZE)
     peak = -np.inf
     for k in range(shapes.shape[0]):
         y[:3] = com
         y[3:7] = NK.matrix_quat(rot)
         y[7:13] = omegas[k] * shapes[k]
+        if springs.size:
+            peak = max(peak, NK.compatible_tensions(y, arms, anchors, inertia, mass, gravity, air, springs, base).max())
+            stretch = springs * np.abs(NK.dynamics_jacobian(y, arms, anchors) @ shapes[k])
+            peak = max(peak, (base + stretch).max())
+            continue
         peak = max(peak, NK.tensions(y, arms, anchors, inertia, mass, gravity, air).max())
         for sign in (1.0, -1.0):
             y[:3] = com + sign * shapes[k, :3]

@@ -42,6 +42,7 @@ from bifilar.bodies.boat import load_suspension
 from bifilar.bodies.composite import Part
 from bifilar.rig import Rig, RigError, load_rig
 from bifilar.rig.checks import no_unknown, number, positive, read_toml, required, table
+from bifilar.rig.file import check_heavy_inextensible
 from bifilar.rig.ranges import check_ranges
 from bifilar.sweep.axes import AXES, POSITIVE, attach_span_of, configure
 
@@ -132,10 +133,16 @@ def _check_axis(rig: Rig, name: str, values: np.ndarray, src: str, field: str) -
             raise RigError(src, field, f"must be from 0 to under half the base rig's attachment span ({half:g} m); "
                                        f"found {values.min():g} to {values.max():g}")
     for value in sorted({float(values.min()), float(values.max())}):
+        configured = configure(rig, {name: value})
         try:  # the rig file's ranges (bifilar.rig.ranges), on the base rig with this axis at this value
-            check_ranges(configure(rig, {name: value}))
+            check_ranges(configured)
         except RigError as exc:
             raise RigError(src, field, f"{value:g} is outside the rig file's ranges ({exc.field}: {exc.problem})") from None
+        try:  # and the file's rules across fields: an elastic axis on heavy wires (issue 35 item 6)
+            check_heavy_inextensible(configured.wires, src)
+        except RigError as exc:
+            raise RigError(src, field, f"{value:g} makes a rig that a rig file refuses ({exc.field} of the base "
+                                       f"rig: {exc.problem})") from None
 
 
 def _points(raw, src: str) -> tuple[dict[str, np.ndarray], tuple]:
