@@ -48,7 +48,8 @@ def test_stiff_wires_keep_their_slow_modes_and_identify(tmp_path, capsys):
 
 def _sweep_space(tmp_path, rig_text: str, vary: str, axes: str = '["z"]'):
     (tmp_path / "rig.toml").write_text(rig_text)
-    (tmp_path / "space.toml").write_text(f'rig = "rig.toml"\n[vary]\n{vary}\n[measure]\naxes = {axes}\namplitude = 0.05\n')
+    (tmp_path / "space.toml").write_text(f'rig = "rig.toml"\n[vary]\n{vary}\n[measure]\naxes = {axes}\n'
+                                         'amplitude = 0.05\n')
     return tmp_path / "space.toml"
 
 
@@ -80,7 +81,8 @@ def test_stiff_wires_of_unequal_length_settle(tmp_path, capsys):
     lin = _json(capsys, "modes", str(path))
     assert min(lin["equilibrium"]["tensions"]) > 0.0
     periods = {m["motion"]: m["period"] for m in lin["modes"]}
-    assert periods["sway x"] == pytest.approx(2.61484, abs=1e-4) and periods["sway y"] == pytest.approx(2.21191, abs=1e-4)
+    assert periods["sway x"] == pytest.approx(2.61484, abs=1e-4)
+    assert periods["sway y"] == pytest.approx(2.21191, abs=1e-4)
 
 
 @pytest.mark.parametrize("vary", ["[vary]\naxial_stiffness = [1e5, 1e6]", "[[point]]\naxial_stiffness = 1e5"])
@@ -119,8 +121,9 @@ def test_tensor_of_an_elastic_platform_from_a_rough_start(tmp_path, capsys, star
     for e in SEVEN:
         q = plan.vertical_orientation(e)
         hung = replace(base, com=q @ TRUE_COM, inertia=q @ TRUE_INERTIA @ q.T)
-        tables.append(f'[[hanging]]\nrig = "object.toml"\norientation = {Rotation.from_matrix(q).as_rotvec().tolist()}\n'
-                      f"period = {linear_period(hung, 'z')!r}\n")
+        turn = Rotation.from_matrix(q).as_rotvec().tolist()
+        period = linear_period(hung, "z")
+        tables.append(f'[[hanging]]\nrig = "object.toml"\norientation = {turn}\nperiod = {period!r}\n')
     path = tmp_path / "hangings.toml"
     path.write_text("\n".join(tables))
     report = _json(capsys, "tensor", str(path))
