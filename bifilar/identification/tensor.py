@@ -50,6 +50,7 @@ _PAIRS = ((0, 0), (1, 1), (2, 2), (0, 1), (1, 2), (0, 2))
 _RANK_RTOL = 1e-8  # singular values of the relative Jacobian below this fraction are undetermined
 _TOL = 1e-11  # relative step at convergence: eigh rounding moves a small object on a heavy fixture ~4e-14
 _ITERATIONS = 50
+_HALVINGS = 40  # a Gauss-Newton step is halved at most this often to find a trial the objective accepts
 # A yaw is told from the other modes when no other mode turns about the vertical with more than this
 # share of the yaw's own angular velocity there (per unit kinetic energy, squared): above it a record
 # of "the yaw" may be either mode, and the period does not say which moment it measures.
@@ -209,9 +210,8 @@ def identify_tensor(hangings: list[Hanging], start: np.ndarray, tares: tuple[Tar
     weighted = bool(np.all(sigma > 0.0))
     x = components_of(np.asarray(start, float))
     scale = float(np.trace(start) / 3.0)
+    t, jac = _periods(models, x, source)
     for _ in range(_ITERATIONS):
-        out = [m.period(x) for m in models]
-        t, jac = np.array([o[0] for o in out]), np.array([o[1] for o in out])
         rel = jac * scale / measured[:, None]  # d ln T / d (X / scale)
         sv = np.linalg.svd(rel, compute_uv=False)
         if np.sum(sv > _RANK_RTOL * sv[0]) < 6:
@@ -220,9 +220,11 @@ def identify_tensor(hangings: list[Hanging], start: np.ndarray, tares: tuple[Tar
                            "more distinct object axes vertical, some between the principal axes)")
         root = _whitener(models, hangings, tares, x, measured, sigma) if weighted else np.eye(len(hangings))
         step = np.linalg.lstsq(root @ rel, root @ ((measured - t) / measured), rcond=None)[0] * scale
-        x = x + step
-        if np.abs(step).max() < _TOL * scale:
+        if np.abs(step).max() < _TOL * scale:  # converged: the last step, to rounding
+            x = x + step
+            t, jac = _periods(models, x, source, final=True)
             break
+        x, t, jac = _damped(models, x, t, step, root, measured, source)
     else:
         raise RigError(source, "hanging", "the tensor did not converge: the periods are not consistent with one body")
     inertia = tensor_of(x)
@@ -232,8 +234,6 @@ def identify_tensor(hangings: list[Hanging], start: np.ndarray, tares: tuple[Tar
                                           f"{moments})")
     if moments[0] + moments[1] < moments[2] * (1.0 - 1e-9):
         raise RigError(source, "hanging", f"the periods give a tensor breaking I1 + I2 >= I3 (principal {moments})")
-    out = [m.period(x) for m in models]
-    t, jac = np.array([o[0] for o in out]), np.array([o[1] for o in out])
     if not weighted:
         return Tensor(inertia, None, t, None, None)
     c = period_covariance(models, hangings, tares, x, sigma)
@@ -243,6 +243,44 @@ def identify_tensor(hangings: list[Hanging], start: np.ndarray, tares: tuple[Tar
     dof = len(hangings) - 6
     chi2 = float(r @ ci @ r) / dof if dof > 0 else None
     return Tensor(inertia, covariance, t, r / np.sqrt(np.diag(c)), chi2)
+
+
+def _periods(models: list[Linear], x: np.ndarray, source: str, final: bool = False):
+    """(T, d T / d components) of every hanging at components ``x``. A yaw that cannot be told from another
+    mode at the start or at the result (``final``) is the hangings file's problem: named there."""
+    try:
+        out = [m.period(x) for m in models]
+    except RigError as exc:
+        where = "the result" if final else "the start"
+        raise RigError(source, f"{exc.source}.{exc.field}", f"at {where}: {exc.problem}") from None
+    return np.array([o[0] for o in out]), np.array([o[1] for o in out])
+
+
+def _damped(models: list[Linear], x: np.ndarray, t: np.ndarray, step: np.ndarray, root: np.ndarray,
+            measured: np.ndarray, source: str):
+    """(x, T, d T / d x) after the Gauss-Newton ``step``, halved until the trial is a tensor that holds every
+    hanging's mass matrix positive definite, its yaw told from the other modes, and the weighted residual
+    no larger (to rounding). Why: from a rough start (an isotropic guess 4x the true moments) the full step
+    left the tensors a rig can have: the trial's eigen-solve failed, or its yaw mixed with a sway, a fault
+    of the iterate and not of the data (issue 35 item 7). Refused if no trial in :data:`_HALVINGS` halvings."""
+    def objective(periods):
+        r = root @ ((measured - periods) / measured)
+        return float(r @ r)
+
+    current = objective(t)
+    for _ in range(_HALVINGS):
+        trial = x + step
+        try:
+            if np.linalg.eigvalsh(tensor_of(trial))[0] > 0.0:
+                out = [m.period(trial) for m in models]
+                periods = np.array([o[0] for o in out])
+                if objective(periods) <= current * (1.0 + 1e-9):
+                    return trial, periods, np.array([o[1] for o in out])
+        except (RigError, np.linalg.LinAlgError):
+            pass
+        step = 0.5 * step
+    raise RigError(source, "hanging", "the tensor did not converge: no step from the last estimate lowers the "
+                   "periods' misfit (the periods are not consistent with one body, or the start is too far)")
 
 
 def period_covariance(models: list[Linear], hangings: list[Hanging], tares: tuple[Tare, ...], x: np.ndarray,

@@ -120,7 +120,8 @@ def minimise(rig: Rig, com: np.ndarray, rotation: np.ndarray, arms: np.ndarray, 
 
 def settle(rig: Rig, com: np.ndarray, rotation: np.ndarray, arms: np.ndarray, anchors: np.ndarray, scale: float,
            fixed_rotation: bool = False):
-    """:func:`minimise` from a pose (``fixed_rotation``: the COM alone), continued in the wires' stiffness: (com, rotation, tensions, converged).
+    """:func:`minimise` from a pose (``fixed_rotation``: the COM alone), continued in the wires' stiffness:
+    (com, rotation, tensions, converged).
 
     Why: V's valley across the wires' directions is ~W / sum k wide, ~1e-9 m at E A = 1e10 N, and a wire
     slack on one side of it and taut on the other: from a start a visible distance away the trust region
