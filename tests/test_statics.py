@@ -91,7 +91,7 @@ def test_rest_pose_does_not_depend_on_the_body_frame(turn):
 def test_the_rest_search_slopes_are_the_rotation_s_derivatives(v):
     # d(R(v) r)/dv = -[R(v) r]x J_l(v), the constraint Jacobian SLSQP is given in the rest-pose search:
     # against central differences of scipy's rotation (step 1e-6: truncation ~1e-12, rounding ~1e-10).
-    from bifilar.rig.statics import _left_jacobian, _skew
+    from bifilar.rig.so3 import left_jacobian as _left_jacobian, skew as _skew
 
     v, r, h = np.array(v), np.array([0.2, -0.5, 0.7]), 1e-6
     numeric = np.column_stack([(Rotation.from_rotvec(v + h * e).apply(r) - Rotation.from_rotvec(v - h * e).apply(r))
@@ -104,6 +104,6 @@ def test_the_rest_search_slopes_are_the_rotation_s_derivatives(v):
 def test_the_rest_search_rotation_is_scipy_s(v):
     # Rodrigues' formula (the search's inner loop) against scipy's quaternion route: the same matrix to a
     # few units of rounding (entries of order 1), on both sides of the series' switch at |v| = 1e-6.
-    from bifilar.rig.statics import _rotation
+    from bifilar.rig.so3 import rotation as _rotation
 
     np.testing.assert_allclose(_rotation(np.array(v)), Rotation.from_rotvec(v).as_matrix(), rtol=0, atol=4e-16)

@@ -19,7 +19,6 @@ world frame). Both engines start from :func:`initial_state`, so that they integr
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -27,7 +26,7 @@ from scipy.optimize import least_squares, minimize
 from scipy.spatial.transform import Rotation
 
 from bifilar.jit import LoopKernels
-from bifilar.rig import Rig, RigError, pose_kernel
+from bifilar.rig import Rig, RigError, pose_kernel, so3
 
 # The pose kernels (also for modes.py): one rig's rest pose and modes in plain Python, compiled once
 # they loop (bifilar.jit.LoopKernels).
@@ -323,7 +322,7 @@ def _search(rig: Rig, start: np.ndarray) -> Rest:
         """The arms turned by rotvec x[3:6] and the anchor-to-attachment vectors (world, m)."""
         key = x.tobytes()
         if last.get("x") != key:
-            r = turned @ _rotation(x[3:6]).T
+            r = turned @ so3.rotation(x[3:6]).T
             last.update(x=key, spans=(r, x[:3] + r - ends))
         return last["spans"]
 
@@ -339,7 +338,7 @@ def _search(rig: Rig, start: np.ndarray) -> Rest:
         u = s / np.sqrt(np.einsum("wi,wi->w", s, s))[:, None]
         (rx, ry, rz), (ux, uy, uz) = r.T, u.T
         turn = np.column_stack((ry * uz - rz * uy, rz * ux - rx * uz, rx * uy - ry * ux))
-        return np.hstack([u, turn @ _left_jacobian(x[3:6])]) / scale
+        return np.hstack([u, turn @ so3.left_jacobian(x[3:6])]) / scale
 
     coarse = minimize(
         lambda x: x[2] / scale,
@@ -389,32 +388,6 @@ def _search(rig: Rig, start: np.ndarray) -> Rest:
     if not _stable(rig, rest):
         raise RigError(rig.source, "wire", "the only equilibrium with every wire taut found is unstable: no rest pose")
     return rest
-
-
-def _rotation(v: np.ndarray) -> np.ndarray:
-    """exp([v]x) by Rodrigues' formula, I + sin t / t K + (1 - cos t) / t^2 K^2 (K = [v]x, t = |v|): the
-    search's inner loop, where scipy's Rotation (a quaternion object per call) took two thirds of the
-    time; the same matrix to rounding (tests/test_statics.py)."""
-    t = float(np.linalg.norm(v))
-    k = _skew(v)
-    if t < 1e-6:  # the series: 1 - t^2/6 and 1/2 - t^2/24
-        return np.eye(3) + (1.0 - t * t / 6.0) * k + (0.5 - t * t / 24.0) * (k @ k)
-    return np.eye(3) + math.sin(t) / t * k + (1.0 - math.cos(t)) / t**2 * (k @ k)
-
-
-def _skew(v: np.ndarray) -> np.ndarray:
-    """[v]x, the matrix of the cross product v x ."""
-    return np.array([[0.0, -v[2], v[1]], [v[2], 0.0, -v[0]], [-v[1], v[0], 0.0]])
-
-
-def _left_jacobian(v: np.ndarray) -> np.ndarray:
-    """J_l(v) = I + (1 - cos t) / t^2 K + (t - sin t) / t^3 K^2 (K = [v]x, t = |v|): exp([v + dv]x) =
-    exp([J_l dv]x) exp([v]x) to first order, so d(R(v) r) / dv = -[R(v) r]x J_l(v)."""
-    t = float(np.linalg.norm(v))
-    k = _skew(v)
-    if t < 1e-6:  # the series: 1/2 - t^2/24 and 1/6 - t^2/120
-        return np.eye(3) + (0.5 - t * t / 24.0) * k + (1.0 / 6.0 - t * t / 120.0) * (k @ k)
-    return np.eye(3) + (1.0 - math.cos(t)) / t**2 * k + (t - math.sin(t)) / t**3 * (k @ k)
 
 
 class Indeterminate(RigError):
