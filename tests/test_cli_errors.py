@@ -11,22 +11,11 @@ from pathlib import Path
 
 import pytest
 
+from test_robust import one_error, run_cli
+
 from validate.cli import main
 
 ROOT = Path(__file__).resolve().parents[1]
-
-
-def run_cli(capsys, *args):
-    code = main([str(a) for a in args])
-    out, err = capsys.readouterr()
-    return code, out, err
-
-
-def one_error(err: str) -> str:
-    lines = err.strip().splitlines()
-    assert len(lines) == 1, err
-    assert lines[0].startswith("error: "), err
-    return lines[0]
 
 
 # ------------------------------------------------------------------------- 8: a folder as a rig
