@@ -3,8 +3,11 @@ to rounding), LoopKernels runs one-shot work in Python until it loops (then comp
 a compile note is printed once per process, and on an empty cache the suite runs the cases that compile
 first."""
 
+import os
+import subprocess
 import sys
 import time
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -113,3 +116,16 @@ def test_on_an_empty_cache_the_compiling_cases_run_first(cold, monkeypatch, tmp_
     last_compiling = max(i for i, (what, n) in enumerate(lines) if what == "end" and n in compiling)
     first_other = min(i for i, (what, n) in enumerate(lines) if what == "start" and n not in compiling)
     assert (last_compiling < first_other) == cold  # warm: the cases in their order, two at a time
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", ["plate", "quadrifilar"])
+def test_one_rigs_modes_compile_nothing(name, tmp_path):
+    """The README's promise: one rig's rest pose and modes run as plain Python on an empty numba cache
+    (nothing is written to it); a kernel called from Python outside LoopKernels would compile there
+    (modes.resolution did, called by linearize's neutral test)."""
+    env = dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path))
+    proc = subprocess.run([sys.executable, "-m", "validate", "modes", name], cwd=Path(__file__).resolve().parents[1],
+                          env=env, capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 0, proc.stderr
+    assert not list(tmp_path.rglob("*.nbi")) and "compiling" not in proc.stderr, proc.stderr

@@ -103,14 +103,17 @@ def resolution(pendulum: float, big: float, rtol: float) -> float:
     frequency: ``rtol`` of the ``pendulum`` scale g / S, or the eigen-solver's round-off on the largest
     |omega^2| ``big`` (:data:`ROUNDOFF_RTOL`) if that is larger. Not a fraction of the largest alone: stiff
     elastic wires put the bounce's omega^2 (~EA / (m L)) 1e9 times above the sways' g / L at EA = 1e10
-    (issue 35 item 4), where a fraction of it would call the sways and the yaw neutral (and one frequency)."""
+    (issue 35 item 4), where a fraction of it would call the sways and the yaw neutral (and one frequency).
+
+    Compiled for the sweep kernel, which calls it; this module calls its Python function
+    (``resolution.py_func``), so that one rig's modes still need no compiler (README)."""
     return max(rtol * pendulum, ROUNDOFF_RTOL * big, 1e-300)
 
 
 def oscillating(w2: np.ndarray, pendulum: float) -> np.ndarray:
     """Which of the eigenvalues ``w2`` are oscillating modes (not neutral or unstable; :func:`resolution`)."""
     big = float(np.abs(w2).max()) if len(w2) else 0.0
-    return w2 > resolution(pendulum, big, NEUTRAL_RTOL)
+    return w2 > resolution.py_func(pendulum, big, NEUTRAL_RTOL)
 
 
 def reduced(rig: Rig, rest: Rest) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -166,7 +169,7 @@ def motion_of(rig: Rig, rest: Rest, com: np.ndarray, rotation: np.ndarray) -> st
 def degenerate_sets(w2: np.ndarray, pendulum: float) -> list[tuple[int, int]]:
     """(start, stop) of each run of two or more ascending eigenvalues ``w2`` that are one frequency:
     within :func:`resolution` (``pendulum``: g / S) of each other."""
-    gap = resolution(pendulum, float(np.abs(w2).max()) if len(w2) else 0.0, DEGENERATE_RTOL)
+    gap = resolution.py_func(pendulum, float(np.abs(w2).max()) if len(w2) else 0.0, DEGENERATE_RTOL)
     sets, k = [], 0
     while k < len(w2):
         j = k + 1
