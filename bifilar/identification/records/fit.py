@@ -318,18 +318,17 @@ def _rough_frequency(rec: _Record) -> float:
     x, v = x[dev <= OUTLIER_Z * mad], v[dev <= OUTLIER_Z * mad]
     span = rec.tau[-1]
     resolution = 2.0 * math.pi / span
-    xs, vs = x, v
-    nyquist = math.pi * (len(xs) - 1) / (xs[-1] - xs[0])
+    nyquist = math.pi * (len(x) - 1) / (x[-1] - x[0])
     grid = np.arange(MIN_CYCLES * resolution, nyquist, 0.5 * resolution)
     if len(grid) < 3:
         raise ValueError(f"the record is too short or too sparse to hold {MIN_CYCLES} cycles")
-    power = lombscargle(xs, vs, grid, floating_mean=True)
+    power = lombscargle(x, v, grid, floating_mean=True)
     k = int(np.argmax(power))
     if k == 0 or k == len(grid) - 1:
         raise ValueError(f"no oscillation peak inside {grid[0]:.4g}..{grid[-1]:.4g} rad/s: fewer than "
                          f"{MIN_CYCLES} cycles, or undersampled")
     fine = grid[k] + np.linspace(-0.5, 0.5, 21) * resolution
-    fpower = lombscargle(xs, vs, fine, floating_mean=True)
+    fpower = lombscargle(x, v, fine, floating_mean=True)
     return float(fine[int(np.argmax(fpower))])
 
 
