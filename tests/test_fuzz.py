@@ -30,7 +30,8 @@ from hypothesis import strategies as st
 from validate.assets import MODELS, RIGS
 from validate.cli import main
 
-PROFILES = [pytest.param("fast", id="fast"), pytest.param("long", id="long", marks=[pytest.mark.fuzz, pytest.mark.slow])]
+PROFILES = [pytest.param("fast", id="fast"),
+            pytest.param("long", id="long", marks=[pytest.mark.fuzz, pytest.mark.slow])]
 # examples per property: (fast, long); the long counts add up to 10,000.
 EXAMPLES = {"rig_text": (120, 3500), "extreme": (25, 1500), "simulate": (6, 500), "argv": (150, 3000),
             "signal": (15, 1000), "sweep": (40, 500)}

@@ -51,7 +51,8 @@ axes = ["x", "y", "z"]
 """
 
 
-@pytest.mark.parametrize("name", ["bench_plate.toml", pytest.param("trifilar", marks=pytest.mark.slow), "parallel.toml"])
+@pytest.mark.parametrize("name", ["bench_plate.toml", pytest.param("trifilar", marks=pytest.mark.slow),
+                                  "parallel.toml"])
 def test_continued_rows_equal_general_path(name, monkeypatch, tmp_path):
     if name == "trifilar":
         rig = (MODELS / "rigs" / "trifilar_asymmetric.toml").read_text()

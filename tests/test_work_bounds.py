@@ -3,7 +3,6 @@ candidate files end in seconds, with one line and exit 2 where the input is wron
 
 import json
 import math
-import os
 import subprocess
 import sys
 import time
@@ -23,10 +22,10 @@ HANG = 30.0  # s: a command still running then would have run on (each finished 
 
 
 def cli(*args: str, timeout: float = HANG) -> subprocess.CompletedProcess:
-    """``python -m validate ARGS`` with this tree's code; a hang fails the test at ``timeout``."""
-    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    """``python -m validate ARGS`` from the project root (its code first on the path); a hang fails the
+    test at ``timeout``."""
     return subprocess.run([sys.executable, "-m", "validate", *args], capture_output=True, text=True, timeout=timeout,
-                          env=env, cwd=ROOT)
+                          cwd=ROOT)
 
 
 def write(path: Path, t: np.ndarray, y: np.ndarray) -> str:
