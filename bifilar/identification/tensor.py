@@ -249,10 +249,15 @@ def _periods(models: list[Linear], x: np.ndarray, source: str, final: bool = Fal
     """(T, d T / d components) of every hanging at components ``x``. A yaw that cannot be told from another
     mode at the start or at the result (``final``) is the hangings file's problem: named there."""
     try:
-        out = [m.period(x) for m in models]
+        return _evaluate(models, x)
     except RigError as exc:
         where = "the result" if final else "the start"
         raise RigError(source, f"{exc.source}.{exc.field}", f"at {where}: {exc.problem}") from None
+
+
+def _evaluate(models: list[Linear], x: np.ndarray):
+    """(T, d T / d components) of every hanging at components ``x``, as :meth:`Linear.period` raises."""
+    out = [m.period(x) for m in models]
     return np.array([o[0] for o in out]), np.array([o[1] for o in out])
 
 
@@ -272,10 +277,9 @@ def _damped(models: list[Linear], x: np.ndarray, t: np.ndarray, step: np.ndarray
         trial = x + step
         try:
             if np.linalg.eigvalsh(tensor_of(trial))[0] > 0.0:
-                out = [m.period(trial) for m in models]
-                periods = np.array([o[0] for o in out])
+                periods, jac = _evaluate(models, trial)
                 if objective(periods) <= current * (1.0 + 1e-9):
-                    return trial, periods, np.array([o[1] for o in out])
+                    return trial, periods, jac
         except (RigError, np.linalg.LinAlgError):
             pass
         step = 0.5 * step
