@@ -7,7 +7,9 @@
    phase and learns the real law's excess from the record's own T(A));
 3. check that the swing the record implies is one the rig can make (an angle in degrees read as
    radians, a rate in deg/s read as rad/s, the wrong column: refused in one line naming the likely
-   unit, :func:`swing_problem`; the fit checks it on its first cycles, before the law is built);
+   unit, :func:`swing_problem`; the fit checks it on its first cycles, before the law is built); a
+   plausible swing whose periods change with it as a swing 180 / pi times smaller would is flagged
+   (:mod:`.units`);
 4. for a mode that is not a symmetric torsion, the law is the Kane model's series at the identified
    moment with its quintic matched at the record's amplitude: refit once if it moved;
 5. invert the zero-amplitude period into the moment (:func:`bifilar.identification.identify.invert_period`);
@@ -34,6 +36,7 @@ from .bounds import Deadline, LawBandError, WorkSpent
 from .fit import OscillationFit, SwingError, fit_oscillation
 from .law import EXCESS_PRIOR, AmplitudeLaw, law_for
 from .read import Record, read_record
+from .units import degrees_read_as_rad
 
 CONSISTENCY = 0.99  # chi^2 quantile above which the trials are called inconsistent
 HALVES_Z = 3.0  # halves further apart than this many sigmas: flagged
@@ -222,6 +225,10 @@ def _flags(record: Record, fit: OscillationFit, halves: Halves | None, options: 
     flags = []
     if fit.amplitude is not None and record.kind != "proportional" and fit.amplitude[0] > SUSPECT_TORSION:
         flags.append(f"{name}: a swing of {fit.amplitude[0]:.3g} rad is more than pi/2: check the angle unit")
+    if options.angle_unit == "rad" and record.kind != "proportional":
+        unit = degrees_read_as_rad(fit, record.kind, options.law_sigma)
+        if unit:
+            flags.append(f"{name}: {unit}")
     if fit.law.note:
         flags.append(f"{name}: {fit.law.note}; give --max-amplitude (rad) or --amplitude-scale (units per rad) "
                      "to correct it")
