@@ -7,6 +7,7 @@ import math
 
 import numpy as np
 import pytest
+from scipy.integrate import solve_ivp
 from scipy.stats import binom
 
 from bifilar.identification.records import AmplitudeLaw, Record, RecordOptions, fit_oscillation, identify_records
@@ -24,15 +25,47 @@ Z95 = 1.959963984540054
 
 
 def test_exact_law_ratio_is_the_lagrange_quadrature():
-    """The law's own T(A)/T0 (vectorised RK4, 1024 steps a period) against lagrange.period's
-    quadrature (1e-13): to 1e-9, the spline between the table's knots included."""
+    """The law's own T(A)/T0 (the energy integral of its rho, lam form, Gauss-Legendre) against
+    lagrange.period's quadrature of the rig (1e-13): at a knot (the ratio's last one is A) both are exact
+    to rounding, 1e-12; between the table's knots the spline in A^2 holds 1e-9."""
     omega = 2.0 * math.pi / L.linear_period(BENCH)
     assert LAW.coefficient(omega) == pytest.approx(L.period_amplitude_coefficient(BENCH), rel=1e-12)
     table = LAW.table(omega, 1.4)
     for a in (0.05, 0.3, 0.77, 1.0, 1.4):
         exact = L.period(BENCH, a) / L.linear_period(BENCH)
-        assert LAW.ratio(a, omega) == pytest.approx(exact, rel=1e-9)
+        assert LAW.ratio(a, omega) == pytest.approx(exact, rel=1e-12)
         assert float(table.ratio_at(a)) == pytest.approx(exact, rel=1e-9)
+
+
+@pytest.mark.parametrize("law", [AmplitudeLaw("series", s=0.086, quintic=-0.02), AmplitudeLaw("series", s=-0.03),
+                                 AmplitudeLaw("exact", rho=3.2, lam=0.02)], ids=["series", "softening", "exact-wide"])
+def test_law_table_is_its_equation_of_motion_integrated(law):
+    """The table's energy integral against the law's own equation of motion (``acceleration``)
+    integrated from rest at A by scipy's DOP853 at rtol 1e-12, the quarter period at the first zero
+    crossing (an event): the two agree to 1e-9 (the integrator's tolerance times the crossing's
+    sensitivity), up to 0.98 of the law's limit where the exact law's r nears zero."""
+    omega = 3.1
+    top = 0.98 * law.limit if law.kind == "exact" else 1.2
+    table = law.table(omega, top)
+
+    def crossing(t, y):
+        return y[0]
+
+    crossing.terminal, crossing.direction = True, -1
+    for a in table.amplitude[[0, 11, -1]]:
+        run = solve_ivp(lambda t, y: [y[1], law.acceleration(y[0], y[1], omega)], (0.0, 10.0 / omega), [a, 0.0],
+                        method="DOP853", rtol=1e-12, atol=1e-14 * a, events=crossing)
+        quarter = run.t_events[0][0]
+        assert law.ratio(a, omega) == pytest.approx(4.0 * quarter * omega / (2.0 * math.pi), rel=1e-9)
+
+
+def test_a_law_that_does_not_return_is_refused():
+    """A softening series law, s = 0.3: its potential V = omega^2 (A^2 / 2 - 2 s A^4 / 3) peaks at
+    A^2 = 3 / (8 s) = 1.25, A = 1.118 rad; a swing from 1.2 rad never comes back, one from 1.0 rad does."""
+    law = AmplitudeLaw("series", s=0.3)
+    assert law.ratio(1.0, 2.0) > 1.0
+    with pytest.raises(RigError, match="does not return from 1.2 rad"):
+        law.table(2.0, 1.2)
 
 
 def test_matched_quintic_holds_both_ends_of_the_amplitude_range():
