@@ -1,9 +1,12 @@
 """Rest pose, static tensions and the rig file's [initial] semantics (engine-neutral statics)."""
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
+from bifilar.rig import statics
 from bifilar.rig.statics import attachments, initial_state, length_errors, rest_pose
 from validate.assets import rig
 
@@ -107,3 +110,18 @@ def test_the_rest_search_rotation_is_scipy_s(v):
     from bifilar.rig.so3 import rotation as _rotation
 
     np.testing.assert_allclose(_rotation(np.array(v)), Rotation.from_rotvec(v).as_matrix(), rtol=0, atol=4e-16)
+
+
+def test_a_remembered_rest_pose_is_the_search_s_for_another_inertia():
+    """The rest pose is remembered by the wires, COM, mass and gravity: a rig that differs only in its
+    inertia gets exactly (bitwise) what a fresh multi-start search gives it, as a copy the caller may
+    change without changing the next caller's."""
+    first = rig("trifilar_asymmetric")
+    heavier = replace(first, inertia=first.inertia * 3.0 + np.diag([0.0, 0.01, 0.0]))
+    rest_pose(first)
+    remembered = rest_pose(heavier)
+    fresh = statics._global_rest_pose(heavier)
+    for part in ("com", "rotation", "tensions"):
+        assert np.array_equal(getattr(remembered, part), getattr(fresh, part))
+    remembered.com[:] = 1.0
+    assert np.array_equal(rest_pose(heavier).com, fresh.com)

@@ -139,7 +139,28 @@ def rest_pose(rig: Rig, guess: Rest | None = None) -> Rest:
             # A neutral tilt (COM on the attachment line) leaves Newton anywhere along it: the same
             # representative as without a guess.
             return Rest(rest.com, _nearest_on_neutral_axis(rig, rest.com, rest.rotation), rest.tensions)
-    return _global_rest_pose(rig)
+    return _remembered_rest_pose(rig)
+
+
+_MEMO_SIZE = 64  # rest poses remembered per process (a few kB each)
+_memo: dict = {}
+
+
+def _remembered_rest_pose(rig: Rig) -> Rest:
+    """:func:`_global_rest_pose`, remembered by what it depends on: the wires, the COM, the mass and
+    gravity, not the inertia. A tensor fit or a tare hangs the same few rigs with many trial inertias
+    (82 multi-start searches of 8 rigs in the tare case, ~70 ms each). The inertia enters only the
+    stability check's neutral threshold, so a remembered pose is checked again for this rig (and
+    searched afresh if it fails). Copies are returned: a caller may not change the remembered one."""
+    key = (rig.mass, rig.gravity, rig.com.tobytes(),
+           tuple((w.anchor.tobytes(), w.attach.tobytes(), w.length, w.linear_density) for w in rig.wires))
+    rest = _memo.get(key)
+    if rest is None or not _stable(rig, rest):
+        rest = _global_rest_pose(rig)
+        if len(_memo) >= _MEMO_SIZE:
+            _memo.pop(next(iter(_memo)))  # the oldest
+        _memo[key] = rest
+    return Rest(rest.com.copy(), rest.rotation.copy(), rest.tensions.copy())
 
 
 def _elastic_rest_pose(rig: Rig, guess: Rest | None) -> Rest:
@@ -157,7 +178,7 @@ def _elastic_rest_pose(rig: Rig, guess: Rest | None) -> Rest:
         # start: measured ~6 s per quadrifilar MuJoCo run, where its elastic rest pose is 8 ms).
         rigid = replace(rig, wires=tuple(replace(w, axial_stiffness=None) for w in rig.wires))
         try:
-            rest = _global_rest_pose(rigid)
+            rest = _remembered_rest_pose(rigid)
             starts.append((rest.com, rest.rotation))
         except (RigError, np.linalg.LinAlgError):
             pass
