@@ -15,7 +15,8 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from bifilar.identification.identify import linear_period
+from bifilar.identification.hangings import _vertical, fit_hangings, read_hangings
+from bifilar.identification.identify import identify, linear_period, simulated_period
 from bifilar.identification.tensor import Hanging, Linear, components_of, identify_tensor
 from bifilar.rig import RigError
 from validate.assets import rig
@@ -159,6 +160,36 @@ def test_plan_beats_the_textbook_hangings(tmp_path, capsys):
     (tmp_path / "c.toml").write_text('rig = "rig.toml"\ngenerate = 80\n')
     assert main(["plan", str(tmp_path / "c.toml"), "--count", "6"]) == 2
     assert "period_std: missing" in capsys.readouterr().err
+
+
+@pytest.mark.slow
+def test_a_hanging_at_an_amplitude_is_identify_s_moment(tmp_path):
+    """Issue 36: a period timed at 0.3 rad, given with its amplitude. The hangings took it to zero
+    amplitude once, by the law of the rig hung with the start tensor, where identify() iterates J =
+    invert(T / ratio(J)): the moments differed by ~1e-6. Now the tensor iterates the same fixed point:
+    from the Kane model's periods of the true tensor it comes back to rounding, and each hanging's
+    moment about its vertical is identify()'s for its rig, period and amplitude to 1e-12 (both fixed
+    points stopped at 1e-11 steps, which leave ~1e-13)."""
+    amplitude = 0.3
+    wires = "".join(f"[[wire]]\nanchor = {w.anchor.tolist()}\nattach = {w.attach.tolist()}\nlength = {w.length!r}\n"
+                    for w in rig("trifilar").wires)
+    (tmp_path / "object.toml").write_text(f"[body]\nmass = 2.0\ncom = {TRUE_COM.tolist()}\n"
+                                          "inertia = [nan, nan, nan]\n" + wires)
+    tables, periods = [], []
+    for e in SEVEN:
+        hung, q = mounted(e, TRUE_INERTIA, TRUE_COM)
+        periods.append(simulated_period(hung, _vertical(hung), amplitude))
+        tables.append(f'[[hanging]]\nrig = "object.toml"\norientation = {Rotation.from_matrix(q).as_rotvec().tolist()}\n'
+                      f"period = {periods[-1]!r}\namplitude = {amplitude}\n")
+    path = tmp_path / "hangings.toml"
+    path.write_text("\n".join(tables))
+    fitted = fit_hangings(read_hangings(path), str(path)).inertia
+    np.testing.assert_allclose(fitted, TRUE_INERTIA, rtol=0, atol=1e-12 * 0.12)
+    for e, period in zip(SEVEN, periods):
+        hung, _ = mounted(e, fitted, TRUE_COM)
+        vertical = _vertical(hung)
+        assert identify(hung, vertical, period, amplitude).moment == pytest.approx(vertical @ hung.inertia @ vertical,
+                                                                                   rel=1e-12)
 
 
 @pytest.mark.slow
