@@ -40,6 +40,7 @@ from .identify import _AMPLITUDE_PASSES, _AMPLITUDE_RTOL, amplitude_ratio, inver
 from .records.law import EXCESS_PRIOR
 from .records.pipeline import RecordOptions, identify_records
 from .tensor import Hanging, Tare, Tensor, identify_tensor, tensor_of
+from .transfer import parallel_axis
 
 _RECORD_KEYS = {"column", "kind", "time_column", "fps", "time_unit", "angle_unit", "from", "to", "law_sigma",
                 "amplitude_scale", "max_amplitude"}
@@ -441,11 +442,6 @@ def _vertical(rig: Rig) -> np.ndarray:
     return rest_pose(rig).rotation.T @ np.array([0.0, 0.0, 1.0])
 
 
-def _parallel(d: np.ndarray) -> np.ndarray:
-    """P(d) = |d|^2 1 - d d^T: the parallel-axis tensor per unit mass (kg m^2 / kg)."""
-    return float(d @ d) * np.eye(3) - np.outer(d, d)
-
-
 def _held(e: _Entry, fixture: Fixture | None, object_mass: float) -> np.ndarray:
     """H: the fixed part of the hanging rig's inertia about its COM, rig body axes (kg m^2)."""
     if fixture is None:
@@ -455,8 +451,8 @@ def _held(e: _Entry, fixture: Fixture | None, object_mass: float) -> np.ndarray:
     m_a = positive(body["mass"], src, "body.mass")
     c_a = vector3(body.get("com", [0.0, 0.0, 0.0]), src, "body.com")
     f = fixture.rig
-    c_o = (m_a * c_a - f.mass * f.com) / object_mass
-    return f.inertia + f.mass * _parallel(f.com - c_a) + object_mass * _parallel(c_o - c_a)
+    c_o = (m_a * c_a - f.mass * f.com) / object_mass  # the object's mass shared by every hanging
+    return f.inertia + parallel_axis(f.mass, f.com - c_a) + parallel_axis(object_mass, c_o - c_a)
 
 
 def _hung(e: _Entry, held: np.ndarray, x: np.ndarray) -> Rig:

@@ -364,21 +364,16 @@ def _transfer(args, report: dict, fixture: dict) -> dict:
     parallel-axis theorem, with the two sigmas combined as independent (conservative: the shared
     geometry errors correlate and partly cancel)."""
     from bifilar.identification.identify import axis_vector
+    from bifilar.identification.transfer import object_part, parallel_axis_moment
 
     rig, fix = load_rig(args.rig, AXIS_INDEX[args.axis]), load_rig(args.tare, AXIS_INDEX[args.axis])
     e = axis_vector(args.axis)
-    m_obj = rig.mass - fix.mass
-    if m_obj <= 0.0:
+    if rig.mass - fix.mass <= 0.0:
         raise RigError(args.tare, "body.mass", f"{fix.mass:g} kg: not less than the rig's {rig.mass:g} kg, so no "
                                                "object is left")
-    c_obj = (rig.mass * rig.com - fix.mass * fix.com) / m_obj
-
-    def perp2(point):
-        d = point - rig.com
-        return float(d @ d - (d @ e) ** 2)
-
-    about_com = report["inertia"] - (fixture["inertia"] + fix.mass * perp2(fix.com))
-    own = about_com - m_obj * perp2(c_obj)
+    m_obj, c_obj = object_part(rig.mass, rig.com, fix.mass, fix.com)
+    about_com = report["inertia"] - (fixture["inertia"] + parallel_axis_moment(fix.mass, fix.com - rig.com, e))
+    own = about_com - parallel_axis_moment(m_obj, c_obj - rig.com, e)
     stds = [report["std"], fixture["std"]]
     std = math.sqrt(sum(s**2 for s in stds)) if all(s is not None for s in stds) else None
     return {"mass": m_obj, "com": c_obj.tolist(), "inertia": own, "std": std,
