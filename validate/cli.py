@@ -150,6 +150,7 @@ _LIKELY_FIELD = {
 
 
 def _likely_field(exc: BaseException) -> str:
+    """The field :data:`_LIKELY_FIELD` names for the innermost frame of ``exc`` it knows, else ``rig``."""
     for frame, _ in reversed(list(traceback.walk_tb(exc.__traceback__))):
         module = frame.f_globals.get("__name__")
         field = _LIKELY_FIELD.get((module, frame.f_code.co_name)) or _LIKELY_FIELD.get(module)
