@@ -180,3 +180,44 @@ def test_absurd_values_in_a_candidates_file_name_the_file_and_field(tmp_path, ca
     code, out, err = run_cli(capsys, "plan", path, "--count", "6")
     assert code == 2 and out == ""
     assert one_error(err).startswith(f"error: {path}: {field}: "), err
+
+
+# ------------------------------------------------------- exit 4: the field blamed, keyed by module
+
+
+def _defines(module, name: str) -> bool:
+    """Whether ``module`` itself defines a function, or a method of one of its classes, whose frames are
+    called ``name`` (what ``validate.cli._likely_field`` matches)."""
+    import inspect
+
+    owners = [module] + [c for c in vars(module).values() if inspect.isclass(c) and c.__module__ == module.__name__]
+    codes = [getattr(getattr(owner, name, None), "__code__", None) for owner in owners]
+    return any(code is not None and code.co_name == name and code.co_filename == module.__file__ for code in codes)
+
+
+def test_every_module_and_function_named_in_the_exit_4_table_exists():
+    """The table cannot go stale unnoticed: a module moved or renamed, or a function renamed, fails here
+    instead of silently changing which field an exit-4 message names."""
+    import importlib
+
+    from validate.cli import _LIKELY_FIELD
+
+    for key in _LIKELY_FIELD:
+        module_name, function = key if isinstance(key, tuple) else (key, None)
+        module = importlib.import_module(module_name)
+        assert function is None or _defines(module, function), f"{module_name} defines no {function}"
+
+
+def test_a_failure_in_a_command_module_itself_names_the_rig(capsys, monkeypatch):
+    """``modes``'s own module (validate/commands/modes.py) is not bifilar/motion/modes.py: a failure whose
+    innermost frames are not in the table names the whole rig, not the field of a namesake file."""
+    import numpy as np
+
+    def singular(*args, **kwargs):
+        raise np.linalg.LinAlgError("Singular matrix")
+
+    monkeypatch.setattr("bifilar.motion.modes.linearize", singular)
+    code, out, err = run_cli(capsys, "modes", ROOT / "models/rigs/plate.toml")
+    assert code == 4 and out == ""
+    assert one_error(err).startswith(f"error: {ROOT / 'models/rigs/plate.toml'}: rig: the modes run failed "
+                                     "(LinAlgError: Singular matrix)"), err

@@ -8,6 +8,12 @@ from __future__ import annotations
 
 OK, CHECK_FAILED, BAD_INPUT, WENT_SLACK, RUN_FAILED, INTERRUPTED, BROKEN_PIPE = 0, 1, 2, 3, 4, 130, 141
 
+
+class RunFailed(Exception):
+    """A run that failed (exit status :data:`RUN_FAILED`): the message is the whole line after ``error: ``.
+    Here rather than in :mod:`validate.cli`, so that the commands raising it need not import the CLI."""
+
+
 MEANING = {
     OK: "success",
     CHECK_FAILED: "a validation check failed",

@@ -23,7 +23,7 @@ FIGURE_SECONDS = 10.0  # s of each motion drawn: 2.4-5 periods
 COLOURS = ((31, 119, 180), (255, 127, 14), (44, 160, 44), (148, 103, 189), (140, 86, 75))  # per configuration
 
 
-def add_parser(subparsers):
+def add_parser(subparsers) -> None:
     """Add the ``boat`` command to ``python -m validate``'s subparsers."""
     from ..statuses import epilog
 
@@ -38,7 +38,6 @@ def add_parser(subparsers):
     p.add_argument("--png", metavar="FILE.png",
                    help=f"also draw the wire tensions (N) of every configuration over {FIGURE_SECONDS:g} s of each "
                         "motion (default: no figure)")
-    return p
 
 
 def run(args) -> int:

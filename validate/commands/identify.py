@@ -45,6 +45,7 @@ from bifilar.identification.records.bounds import SAMPLES_PER_CYCLE, WorkSpent
 from bifilar.identification.records.law import EXCESS_PRIOR
 
 from ..argtypes import UsageError, bounded_float, positive_float, whole_number
+from ..statuses import RunFailed
 
 AXIS_INDEX = {"x": 0, "y": 1, "z": 2}
 WEAK_SENSITIVITY = 0.02  # d ln T / d ln I below this: the period barely depends on the moment
@@ -111,12 +112,10 @@ def run(args) -> int:
             report["object"] = _transfer(args, report, fixture)
             trials = trials + tare_trials
     except WorkSpent as exc:
-        from ..cli import RunFailed
-
         raise RunFailed(f"{exc} (--max-seconds {args.max_seconds:g}): give more, or a shorter record "
                         "(--from, --to)") from None
     if args.png and trials:
-        from .identify_png import draw
+        from ..report.identify_png import draw
 
         draw(trials, args.png)
     if args.html:

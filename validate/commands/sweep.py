@@ -32,6 +32,7 @@ import time
 from pathlib import Path
 
 from ..argtypes import UsageError, whole_number
+from ..statuses import epilog
 
 COLUMNS_AFTER_AXES = (
     ["period_1", "period_2", "period_3", "period_4", "tension_1", "tension_2", "tension_peak",
@@ -41,8 +42,10 @@ COLUMNS_AFTER_AXES = (
 )
 
 
-def add_parser(subparsers):
-    p = subparsers.add_parser("sweep", help="sweep suspension configurations: periods, sigma, tensions, the best rig")
+def add_parser(subparsers) -> None:
+    """Register the ``sweep`` subcommand on the CLI's subparsers."""
+    p = subparsers.add_parser("sweep", help="sweep suspension configurations: periods, sigma, tensions, the best rig",
+                              epilog=epilog("sweep", ("python -m validate sweep bench_plate --out sweep/ --png",)))
     p.add_argument("space", metavar="SPACE.toml", help="the sweep file (format: bifilar/sweep/space.py)")
     p.add_argument("--out", required=True, metavar="DIR", help="folder for sweep.csv, summary.json (and sweep.png)")
     p.add_argument("--jobs", type=whole_number("--jobs", 1, 256), default=None, metavar="N",
@@ -56,7 +59,6 @@ def add_parser(subparsers):
     p.add_argument("--rerun", action="store_true",
                    help="also write DIR/sweep.rrd: the table and the MuJoCo check's motions "
                         "(open: rerun DIR/sweep.rrd)")
-    return p
 
 
 def _cell(x) -> str:

@@ -9,10 +9,9 @@ no law is drawn: it cannot be applied).
 
 from __future__ import annotations
 
-
 import numpy as np
 
-from ..report.figures import png_bytes, pyplot
+from .figures import png_bytes, pyplot
 from ..trajectory import atomic_write_bytes
 
 
