@@ -35,7 +35,7 @@ import numba as nb
 import numpy as np
 from scipy.linalg import eigh
 
-from bifilar.bodies.air import added_mass
+from bifilar.rig.air import added_mass
 from bifilar.rig import Rig
 from bifilar.rig import elastic, heavy
 from bifilar.rig.heavy import has_wire_mass

@@ -31,7 +31,7 @@ from mujoco import rollout
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from bifilar.bodies.air import added_mass
+from bifilar.rig.air import added_mass
 from bifilar.rig import Rig, RigError
 from bifilar.motion.simulate import BudgetSpent, IntegrationError, output_grid
 from bifilar.rig.statics import State, initial_state
