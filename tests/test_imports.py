@@ -44,9 +44,14 @@ def _target(name, modules):
 
 def _imports(module, source, is_package, modules):
     """The set of our modules that `module` (its text `source`) imports anywhere in its body."""
+    return _edges(module, ast.walk(ast.parse(source, module)), is_package, modules)
+
+
+def _edges(module, nodes, is_package, modules):
+    """The set of our modules that the import statements among `nodes` (of `module`) import."""
     package = module if is_package else module.rpartition(".")[0]
     edges = set()
-    for node in ast.walk(ast.parse(source, module)):
+    for node in nodes:
         if isinstance(node, ast.Import):
             names = [alias.name for alias in node.names]
         elif isinstance(node, ast.ImportFrom):
@@ -160,6 +165,21 @@ def test_no_import_cycle():
 
 def test_bifilar_never_imports_validate():
     assert _violations("bifilar", ["validate"]) == []
+
+
+def test_bifilar_hides_no_import_of_its_own_in_a_function():
+    # An import inside a function is for a heavy optional dependency (dask, numba's internals), never
+    # to dodge a cycle between our own modules.
+    modules, hidden = _modules(), set()
+    for module, (path, is_package) in modules.items():
+        if not _within(module, "bifilar"):
+            continue
+        for function in ast.walk(ast.parse(path.read_text(), str(path))):
+            if isinstance(function, (ast.FunctionDef, ast.AsyncFunctionDef)):
+                inner = (node for statement in function.body for node in ast.walk(statement))
+                hidden.update(f"{module}.{function.name} -> {target}"
+                              for target in _edges(module, inner, is_package, modules))
+    assert sorted(hidden) == []
 
 
 def test_rig_is_below_motion_identification_sweep():
