@@ -116,7 +116,7 @@ def run(args) -> int:
         raise RunFailed(f"{exc} (--max-seconds {args.max_seconds:g}): give more, or a shorter record "
                         "(--from, --to)") from None
     if args.png and trials:
-        from .identify_png import draw
+        from ..report.identify_png import draw
 
         draw(trials, args.png)
     if args.html:

@@ -37,7 +37,8 @@ from bifilar.motion.simulate import BudgetSpent, IntegrationError, output_grid
 from bifilar.rig.statics import State, initial_state
 
 from ..trajectory import Trajectory, rig_quaternions
-from . import EngineInputError, mjcf
+from . import mjcf
+from .errors import EngineInputError
 from .mjcf import CHOSEN, Numerics
 
 

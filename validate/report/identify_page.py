@@ -97,7 +97,7 @@ class FitSection(Section):
     def body(self) -> str:
         if not self.trials:
             return tag("p", "A measured period was given: no record was fitted.")
-        from ..commands.identify_png import render
+        from .identify_png import render
 
         caption = ("each record with its fit (rejected samples marked), the residuals, and each cycle's period "
                    "against its amplitude beside the fitted law T0 (1 + s A^2)")
