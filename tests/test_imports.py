@@ -88,8 +88,10 @@ def _parents(target, module, modules):
 
 
 def _graph():
+    """Module -> the set of our modules it imports."""
     modules = _modules()
-    return {module: _imports(module, path.read_text(), is_package, modules) for module, (path, is_package) in modules.items()}
+    return {module: _imports(module, path.read_text(), is_package, modules)
+            for module, (path, is_package) in modules.items()}
 
 
 GRAPH = _graph()
