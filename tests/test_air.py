@@ -1,4 +1,4 @@
-"""The air model (bifilar.bodies.air) and its use in the Kane equations, MuJoCo and identify."""
+"""The air model (bifilar.rig.air) and its use in the Kane equations, MuJoCo and identify."""
 
 import json
 import tomllib
@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from bifilar.bodies.air import (
+from bifilar.rig.air import (
     added_mass,
     added_mass_principal,
     drag_wrench,

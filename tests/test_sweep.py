@@ -200,7 +200,7 @@ def test_a_sweep_in_air_says_how_much_of_each_period_is_air(tmp_path):
     """The foam wing's yaw (air 17.0 % of the measured yaw inertia, case air-wing-share): the sweep's
     air share of the yaw period at the rig's own wire length is the share of the apparent moment,
     I_A / (I + I_A), for this pure rotation, to the modes' coupling (1e-3)."""
-    from bifilar.bodies.air import added_inertia
+    from bifilar.rig.air import added_inertia
     from validate.assets import MODELS, rig as shipped
 
     wing = shipped("foam_wing")

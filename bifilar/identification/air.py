@@ -5,7 +5,7 @@ body's plus the air's added moment about the axis (docs/air.md):
 
     J_body = J_apparent - e6^T M_A e6,   e6 = (0, e),
 
-M_A the added-mass tensor of the rig's ``[air]`` about the COM (:func:`bifilar.bodies.air.added_inertia`).
+M_A the added-mass tensor of the rig's ``[air]`` about the COM (:func:`bifilar.rig.air.added_inertia`).
 This is exact for a mode that turns about a principal axis of the air's ellipsoid through the COM with
 the COM at rest (a symmetric rig's yaw); where the mode also moves the COM, the added mass along that
 motion shifts the period too and the subtraction is first order only. Standard deviation: the
@@ -18,7 +18,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from bifilar.bodies.air import added_inertia
+from bifilar.rig.air import added_inertia
 from bifilar.rig import Rig
 
 

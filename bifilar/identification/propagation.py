@@ -38,7 +38,7 @@ from functools import lru_cache
 import numpy as np
 from scipy.stats import norm
 
-from bifilar.bodies.air import added_mass
+from bifilar.rig.air import added_mass
 from bifilar.identification.identify import Identified, invert_period, linear_period, moment, pencil, with_moment
 from bifilar.identification.slopes_kernel import period_slopes
 from bifilar.motion.modes import Modes, linearize

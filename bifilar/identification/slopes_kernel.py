@@ -26,7 +26,7 @@ from __future__ import annotations
 import numba as nb
 import numpy as np
 
-from bifilar.rig import pose_kernel as PK
+from bifilar.rig import pose_kernel
 
 _SINGULAR = 1e-10  # smallest / largest singular value of the equilibrium Jacobian treated as singular
 _CHORD_STEPS = 2
@@ -54,11 +54,11 @@ def unpack(x, n_wires):
 def tangent_matrices(com, rot, tensions, arms, anchors, mass):
     """(J, K6, M6 translation part): the constraint gradients (N x 6) and the Lagrangian's Hessian
     sum t_i hess g_i (6 x 6) at a pose."""
-    s, u, rho = PK.wire_geometry(com, rot, arms, anchors)
-    jac = PK.constraint_jacobian(s, u)
+    s, u, rho = pose_kernel.wire_geometry(com, rot, arms, anchors)
+    jac = pose_kernel.constraint_jacobian(s, u)
     k6 = np.zeros((6, 6))
     for i in range(arms.shape[0]):
-        k6 += tensions[i] * PK.constraint_hessian(s, u, rho, i)
+        k6 += tensions[i] * pose_kernel.constraint_hessian(s, u, rho, i)
     return jac, k6
 
 
@@ -119,7 +119,7 @@ def period_slopes(x, h, n_wires, gravity, scale, com0, rot0, t0, inertias, shape
     out = np.zeros((n_axes, n_in))
     lengths, anchors, arms, mass = unpack(x, n_wires)
     weight = mass * gravity
-    _, jac_eq = PK.equilibrium_residual(com0, rot0, t0, arms, anchors, lengths, weight, scale)
+    _, jac_eq = pose_kernel.equilibrium_residual(com0, rot0, t0, arms, anchors, lengths, weight, scale)
     sv = np.linalg.svd(jac_eq)[1]
     if not sv[-1] > _SINGULAR * sv[0]:
         return out, False
@@ -139,12 +139,12 @@ def period_slopes(x, h, n_wires, gravity, scale, com0, rot0, t0, inertias, shape
         weight = mass * gravity
         com, rot, tn = com0.copy(), rot0.copy(), t0 / weight
         for _ in range(_CHORD_STEPS):
-            res = PK.equilibrium_balance(com, rot, tn * weight, arms, anchors, lengths, weight, scale)
+            res = pose_kernel.equilibrium_balance(com, rot, tn * weight, arms, anchors, lengths, weight, scale)
             step = -(inverse @ res)
             com += step[:3]
-            rot = PK.rotation_vector_matrix(step[3:6]) @ rot
+            rot = pose_kernel.rotation_vector_matrix(step[3:6]) @ rot
             tn += step[6:]
-        res = PK.equilibrium_balance(com, rot, tn * weight, arms, anchors, lengths, weight, scale)
+        res = pose_kernel.equilibrium_balance(com, rot, tn * weight, arms, anchors, lengths, weight, scale)
         if not np.abs(res).max() < _CHORD_RESIDUAL:
             return out, False
         jac, k6 = tangent_matrices(com, rot, tn * weight, arms, anchors, mass)

@@ -15,7 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from bifilar.bodies.air import added_mass, drag_parameters
+from bifilar.rig.air import added_mass, drag_parameters
 from bifilar.motion import kane_kernel as K
 from bifilar.rig import Rig, RigError
 from bifilar.rig.statics import State

@@ -23,7 +23,7 @@ each against finite differences of the kinematics and against the appendix where
 docs/thesis-corrections.md lists where it is not.
 
 Air (docs/air.md): with ``p[P_AIR]`` set, the fluid's impulse [P; L] = M_A,w [v; omega] (world frame,
-L about R*, M_A,w the added-mass tensor of :mod:`bifilar.bodies.air` turned to the world) and the drag
+L about R*, M_A,w the added-mass tensor of :mod:`bifilar.rig.air` turned to the world) and the drag
 enter as a wrench on the body: force -dP/dt + F_drag, torque about R* -(dL/dt + v x P) + G_drag
 (Lamb 1932 §124). Its acceleration part adds [Vn; Gn]^T M_A,w [V; G] to the generalised inertia, the
 rest is an active force. Without air the code path is skipped and the equations are those above.
@@ -36,7 +36,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from bifilar.bodies.air import drag_wrench
+from bifilar.rig.air import drag_wrench
 from bifilar.jit import announce_compile
 from bifilar.smallmat import mm as _mm
 from bifilar.smallmat import mv as _mv
@@ -52,7 +52,7 @@ P_AIR = 23  # 1.0 with air, 0.0 in a vacuum
 P_AIR_MASS = slice(24, 60)  # 6x6 added-mass tensor about R* in the n~ frame, row-major
 P_AIR_CENTER = slice(60, 63)  # the air's ellipsoid centre from R*, n~ frame
 P_AIR_AXES = slice(63, 72)  # the ellipsoid's axes (columns) in the n~ frame, row-major
-P_AIR_DRAG = slice(72, 80)  # bifilar.bodies.air.drag_parameters
+P_AIR_DRAG = slice(72, 80)  # bifilar.rig.air.drag_parameters
 P_SIZE = 80
 
 

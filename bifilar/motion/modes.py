@@ -35,11 +35,12 @@ import numba as nb
 import numpy as np
 from scipy.linalg import eigh
 
-from bifilar.bodies.air import added_mass
+from bifilar.rig.air import added_mass
 from bifilar.rig import Rig
 from bifilar.rig import elastic, heavy
 from bifilar.rig.heavy import has_wire_mass
-from bifilar.rig.statics import NULL_RTOL, PK, Rest, State, anchors, arms, rest_pose, rig_scale
+from bifilar.rig.pose_loops import PK
+from bifilar.rig.statics import NULL_RTOL, Rest, State, anchors, arms, rest_pose, rig_scale
 
 # An omega^2 below this fraction of the pendulum's scale g / S (S: rig_scale) is neutral (or unstable), and
 # two closer than it are one frequency; or below the eigen-solver's round-off, ROUNDOFF_RTOL of the

@@ -1,5 +1,5 @@
-"""The rig: its file (body, wires, initial state, uncertainty), the field checks, and its statics
-(rest pose, static tensions, the initial state both engines start from)."""
+"""The rig: its file (body, wires, initial state, uncertainty, the air around the body), the field checks,
+and its statics (rest pose, static tensions, the initial state both engines start from)."""
 
 from bifilar.rig.file import Rig, RigError, Uncertainty, Wire, load_rig, rig_from_dict
 

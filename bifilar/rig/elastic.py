@@ -27,7 +27,7 @@ from dataclasses import replace
 import numpy as np
 
 from bifilar.rig import Rig, RigError
-from bifilar.rig.statics import PK  # the pose kernels, compiled only where they loop (bifilar.jit)
+from bifilar.rig.pose_loops import PK  # the pose kernels, compiled only where they loop (bifilar.jit)
 
 # Converged when every force and moment / S of the gradient is below GRADIENT_TOL W plus the rounding
 # floor ROUNDING x (machine epsilon x S) x sum k_i: a distance rho ~ S is known to eps S, so a stiff wire's

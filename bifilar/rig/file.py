@@ -4,7 +4,7 @@ Units are SI and angles radians. Vectors named ``anchor`` are in the world frame
 -z); ``attach`` and ``com`` are in the body frame, whose origin and axes the file chooses freely; the
 inertia tensor is about the centre of mass along the body axes. Wire 1 is the first ``[[wire]]`` in
 the file, everywhere in this project. An optional ``[air]`` table describes the fluid around the body
-and its aerodynamic shape (:mod:`bifilar.bodies.air`, docs/air.md); without it the body is in a vacuum.
+and its aerodynamic shape (:mod:`bifilar.rig.air`, docs/air.md); without it the body is in a vacuum.
 
 Every problem is raised as :class:`RigError`, which names the file, the field and what is wrong, so
 that the command line can print it as one line and exit with status 2.
@@ -15,10 +15,10 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass, field, replace
 from pathlib import Path
-from typing import TYPE_CHECKING
 
 import numpy as np
 
+from bifilar.rig.air import Air, air_from_dict
 from bifilar.rig.ranges import MAX_WIRES, check_ranges
 from bifilar.rig.checks import (
     RigError,
@@ -31,9 +31,6 @@ from bifilar.rig.checks import (
     table,
     vector3,
 )
-
-if TYPE_CHECKING:
-    from bifilar.bodies.air import Air
 
 __all__ = ["Rig", "RigError", "Uncertainty", "Wire", "load_rig", "rig_from_dict", "check_reachable", "check_hanging"]
 
@@ -83,7 +80,7 @@ class Rig:
     initial_omega: np.ndarray = field(default_factory=lambda: np.zeros(3))  # rad/s, world frame
     uncertainty: Uncertainty = field(default_factory=Uncertainty)
     source: str = "<memory>"
-    air: Air | None = None  # the optional [air] table (bifilar.bodies.air); None: a vacuum
+    air: Air | None = None  # the optional [air] table (bifilar.rig.air); None: a vacuum
 
     @property
     def elastic(self) -> bool:
@@ -173,8 +170,6 @@ def rig_from_dict(data: dict, source: str = "<memory>", default_name: str = "rig
 
     air = None
     if "air" in data:
-        from bifilar.bodies.air import air_from_dict  # bodies.air reads fields with bifilar.rig.checks
-
         air = air_from_dict(table(data, "air", source, mandatory=True), source)
     rig = Rig(
         name=name,

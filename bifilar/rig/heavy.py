@@ -25,7 +25,7 @@ from dataclasses import replace
 import numpy as np
 
 from bifilar.rig import Rig
-from bifilar.rig import pose_kernel as PK
+from bifilar.rig import pose_kernel
 from bifilar.rig.statics import NULL_RTOL, Rest, anchors, arms, rest_pose, rig_scale
 
 __all__ = ["wire_masses", "has_wire_mass", "massless", "lumped", "body_end_tensions", "system", "with_mass_ratio"]
@@ -74,7 +74,7 @@ def kinetic_matrix(rig: Rig, rotation: np.ndarray) -> np.ndarray:
     m6[:3, :3] = rig.mass * np.eye(3)
     m6[3:, 3:] = rotation @ rig.inertia @ rotation.T
     for w, third in zip(rig.wires, wire_masses(rig) / 3.0):
-        p = np.hstack([np.eye(3), -PK.cross_matrix(rotation @ (w.attach - rig.com))])
+        p = np.hstack([np.eye(3), -pose_kernel.cross_matrix(rotation @ (w.attach - rig.com))])
         m6 += third * p.T @ p
     return m6
 
@@ -86,14 +86,14 @@ def system(rig: Rig, guess: Rest | None = None) -> tuple[Rest, np.ndarray, np.nd
     ``guess``: a rest pose of the lumped rig to continue from."""
     light = lumped(rig)
     rest = rest_pose(light, guess=guess)
-    z, _, kr, _ = PK.reduced_matrices(
+    z, _, kr, _ = pose_kernel.reduced_matrices(
         rest.com, rest.rotation, rest.tensions, arms(light), anchors(light), light.inertia, light.mass,
         rig_scale(light), NULL_RTOL,
     )
     offset = rest.rotation @ (rig.com - light.com)  # body COM from the lumped COM, world
     body_com = rest.com + offset
     z = z.copy()
-    z[:3] -= PK.cross_matrix(offset) @ z[3:]  # the body COM moves with x - [d]x theta
+    z[:3] -= pose_kernel.cross_matrix(offset) @ z[3:]  # the body COM moves with x - [d]x theta
     tensions = body_end_tensions(rig, body_com, rest.rotation, rest.tensions)
     return Rest(body_com, rest.rotation, tensions), z, kinetic_matrix(rig, rest.rotation), kr
 

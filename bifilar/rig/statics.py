@@ -25,12 +25,8 @@ import numpy as np
 from scipy.optimize import least_squares, minimize
 from scipy.spatial.transform import Rotation
 
-from bifilar.jit import LoopKernels
-from bifilar.rig import Rig, RigError, pose_kernel, so3
-
-# The pose kernels (also for modes.py): one rig's rest pose and modes in plain Python, compiled once
-# they loop (bifilar.jit.LoopKernels).
-PK = LoopKernels(pose_kernel, "the pose kernels", seconds="10-30")
+from bifilar.rig import Rig, RigError, elastic, so3
+from bifilar.rig.pose_loops import PK  # the pose kernels, compiled only where they loop (bifilar.jit)
 
 # Newton on the equilibrium equations converges quadratically: 30 iterations is ample from any start
 # SLSQP hands it; a residual of 1e-12 (forces / weight, lengths / rig size) is machine precision on
@@ -209,8 +205,6 @@ def _elastic_rest_pose(rig: Rig, guess: Rest | None) -> Rest:
 
 def _lowest_elastic(rig: Rig, starts: list) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The lowest stable minimum on the elastic wires from ``starts``: (com, rotation, tensions)."""
-    from bifilar.rig import elastic
-
     return elastic.rest_pose(rig, starts, arms(rig), anchors(rig), rig_scale(rig))
 
 
@@ -589,8 +583,6 @@ def _elastic_initial_state(rig: Rig, rest: Rest, rotation: np.ndarray) -> State:
     then released with ``initial.omega`` and no COM velocity. A wire may be slack there: it pushes
     nothing. For stiff wires this tends to the inextensible rig's taut shift where the lowest COM on the
     wire spheres is also the nearest (a turn about the vertical: a pure rise)."""
-    from bifilar.rig import elastic
-
     com, _, _, ok = elastic.settle(rig, rest.com, rotation, arms(rig), anchors(rig), rig_scale(rig),
                                    fixed_rotation=True)
     if not ok:

@@ -22,7 +22,7 @@ import numpy as np
 
 from bifilar.motion import nwire_kernel as NK
 from bifilar.motion.modes import resolution  # the neutral and degenerate tests of linearize
-from bifilar.rig import pose_kernel as PK
+from bifilar.rig import pose_kernel
 from bifilar.rig.statics import NEWTON_ITERATIONS, RESIDUAL  # the same Newton as rest_pose
 
 OK, NO_NEWTON, SLACK, NO_MODES, UNSTABLE, NEUTRAL, DEGENERATE = range(7)
@@ -38,13 +38,13 @@ def continued_modes(arms, anchors, lengths, mass, gravity, inertia, scale, com, 
     weight = mass * gravity
     # np.int64: a bare module-level int would be typed Literal[int] and compile newton_equilibrium
     # a second time, beside the int64 signature rest_pose already compiled.
-    com, rot, tensions, residual, _ = PK.newton_equilibrium(com, rot, tensions, arms, anchors, lengths, weight,
-                                                            scale, np.int64(NEWTON_ITERATIONS))
+    com, rot, tensions, residual, _ = pose_kernel.newton_equilibrium(
+        com, rot, tensions, arms, anchors, lengths, weight, scale, np.int64(NEWTON_ITERATIONS))
     if not residual <= RESIDUAL:
         return NO_NEWTON, com, rot, tensions, empty, np.zeros((6, 0))
     if tensions.min() <= 0.0:
         return SLACK, com, rot, tensions, empty, np.zeros((6, 0))
-    z, mr, kr, _ = PK.reduced_matrices(com, rot, tensions, arms, anchors, inertia, mass, scale, null_rtol)
+    z, mr, kr, _ = pose_kernel.reduced_matrices(com, rot, tensions, arms, anchors, inertia, mass, scale, null_rtol)
     n = z.shape[1]
     if n == 0:
         return NO_MODES, com, rot, tensions, empty, np.zeros((6, 0))
@@ -88,7 +88,7 @@ def peak_tension(com, rot, shapes, omegas, springs, base, arms, anchors, inertia
         peak = max(peak, NK.tensions(y, arms, anchors, inertia, mass, gravity, air).max())
         for sign in (1.0, -1.0):
             y[:3] = com + sign * shapes[k, :3]
-            y[3:7] = NK.matrix_quat(PK.rotation_vector_matrix(sign * shapes[k, 3:]) @ rot)
+            y[3:7] = NK.matrix_quat(pose_kernel.rotation_vector_matrix(sign * shapes[k, 3:]) @ rot)
             y[7:13] = 0.0
             peak = max(peak, NK.tensions(y, arms, anchors, inertia, mass, gravity, air).max())
     return peak

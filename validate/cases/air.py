@@ -13,7 +13,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from bifilar.bodies.air import Air, added_inertia, added_mass_principal
+from bifilar.rig.air import Air, added_inertia, added_mass_principal
 from bifilar.identification.records import fit_oscillation
 from bifilar.motion.modes import linearize
 

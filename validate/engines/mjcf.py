@@ -53,7 +53,7 @@ import mujoco
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from bifilar.bodies.air import added_mass
+from bifilar.rig.air import added_mass
 from bifilar.bodies.composite import equivalent_box
 from bifilar.rig import Rig, RigError, load_rig
 from bifilar.rig.statics import Rest, State, attachments, initial_state, rest_pose

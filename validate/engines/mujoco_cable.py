@@ -44,7 +44,7 @@ from bifilar.rig.heavy import lumped
 from bifilar.rig.statics import State, anchors, initial_state
 
 from ..trajectory import Trajectory
-from . import EngineInputError
+from .errors import EngineInputError
 from .mujoco_rig import _check_warnings, _quiet_warnings, jacobian_rate, rig_channels
 
 SEGMENTS = 16  # per wire; the bending it leaves out is second order in the mass ratio

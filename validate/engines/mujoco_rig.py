@@ -31,13 +31,14 @@ from mujoco import rollout
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from bifilar.bodies.air import added_mass
+from bifilar.rig.air import added_mass
 from bifilar.rig import Rig, RigError
 from bifilar.motion.simulate import BudgetSpent, IntegrationError, output_grid
 from bifilar.rig.statics import State, initial_state
 
 from ..trajectory import Trajectory, rig_quaternions
-from . import EngineInputError, mjcf
+from . import mjcf
+from .errors import EngineInputError
 from .mjcf import CHOSEN, Numerics
 
 

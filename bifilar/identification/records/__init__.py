@@ -6,8 +6,8 @@ The loop is :func:`.pipeline.identify_records`: read (:mod:`.read`) -> fit cycle
 """
 
 from .fit import OscillationFit, fit_oscillation
-from .law import EXCESS_PRIOR, AmplitudeLaw, law_for
-from .pipeline import RecordOptions, Trial, identify_records, pool
+from .law import EXCESS_PRIOR, AmplitudeLaw
+from .pipeline import RecordOptions, Trial, identify_records, law_for, pool
 from .read import Record, read_record, unfold
 
 __all__ = ["EXCESS_PRIOR", "AmplitudeLaw", "OscillationFit", "Record", "RecordOptions", "Trial", "fit_oscillation",

@@ -4,7 +4,8 @@ A free oscillation of amplitude A (the peak rotation, rad) has the period T(A) =
 small-amplitude period that the inversion needs. The fit of a record (:mod:`.fit`) measures the period
 at the record's amplitudes; this module says how to take it to A = 0.
 
-The ideal law R(A) is the rig's own (:class:`AmplitudeLaw`):
+The ideal law R(A) is the rig's own (:class:`AmplitudeLaw`; which one a rig has about an axis is chosen
+from its models of motion by :func:`.pipeline.law_for`, so this module needs none of them):
 
 * ``exact``: the exact 1-DOF torsion of :mod:`bifilar.motion.lagrange` (wires of any spacing, the vertical
   kinetic energy kept), (I + m z'^2) theta'' + m z' z'' theta'^2 + m g z' = 0, divided by I: with
@@ -50,7 +51,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 from scipy.interpolate import CubicSpline
 
-from bifilar.rig import Rig, RigError
+from bifilar.rig import RigError
 
 EXCESS_PRIOR = 0.35  # prior std of ds / s (and of dq / s, per rad^2): real rigs differ by up to 30-40 %
 # Gauss-Legendre nodes of the quarter period's integral on [0, pi / 2]: 48 gave R to 4e-14 of an RK4 at
@@ -66,8 +67,6 @@ _GRID = 24  # amplitudes of a table on (0, A_max], dense near both ends: a cubic
 # ~1e-13, the Kane ratio is timed to ~1e-9; 1e-9 and a few secant steps.
 _MATCH_TOL = 1e-9
 _MATCH_STEPS = 6
-# Below this amplitude (rad) the series law's O(A^4) error, ~s^2 A^4, is under 1e-6: no quintic.
-_MATCH_FROM = 0.1
 _LAW_RTOL = 1e-3  # a series law this close to the one fitted with does not change the fit
 
 
@@ -207,24 +206,3 @@ class AmplitudeLaw:
 
 
 LINEAR = AmplitudeLaw()
-
-
-def law_for(rig: Rig, axis, amplitude: float | None = None, rest=None) -> AmplitudeLaw:
-    """The rig's own law about ``axis``: the exact 1-DOF torsion for the vertical axis of a symmetric
-    rig, else the Kane model's period-amplitude series at the rig's moment, right at O(A^2); with the
-    record's largest ``amplitude`` (rad) its quintic is matched to the Kane model's T(A) / T0 there
-    (:meth:`AmplitudeLaw.matched`). ``rest``: the rig's rest pose if known (it does not depend on the
-    inertia)."""
-    from bifilar.identification.identify import AXES, amplitude_coefficient, amplitude_ratio, axis_vector, linear_period
-    from bifilar.motion import lagrange
-
-    if np.allclose(axis_vector(axis), AXES["z"]):
-        try:
-            return AmplitudeLaw.torsion(lagrange.from_rig(rig))
-        except RigError:
-            pass  # not a symmetric torsion: the Kane series below
-    law = AmplitudeLaw("series", s=amplitude_coefficient(rig, axis, rest))
-    if amplitude is not None and amplitude > _MATCH_FROM:
-        omega = 2.0 * math.pi / linear_period(rig, axis, rest)
-        law = law.matched(amplitude, amplitude_ratio(rig, axis, amplitude, rest), omega)
-    return law

@@ -3,7 +3,7 @@
 :func:`identify_records` is the whole loop, in the order it runs:
 
 1. read each file (:func:`.read.read_record`: delimiter, header, units, lost frames, a folded tracker);
-2. fit it with the rig's ideal amplitude law (:func:`.law.law_for`; :mod:`.fit` measures each cycle's
+2. fit it with the rig's ideal amplitude law (:func:`law_for`; :mod:`.fit` measures each cycle's
    phase and learns the real law's excess from the record's own T(A));
 3. check that the swing the record implies is one the rig can make (an angle in degrees read as
    radians, a rate in deg/s read as rad/s, the wrong column: refused in one line naming the likely
@@ -29,12 +29,22 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.stats import chi2
 
-from bifilar.identification.identify import Pencil, invert_period, pencil
+from bifilar.identification.identify import (
+    AXES,
+    Pencil,
+    amplitude_coefficient,
+    amplitude_ratio,
+    axis_vector,
+    invert_period,
+    linear_period,
+    pencil,
+)
+from bifilar.motion import lagrange
 from bifilar.rig import Rig, RigError
 
 from .bounds import Deadline, LawBandError, WorkSpent
 from .fit import OscillationFit, SwingError, fit_oscillation
-from .law import EXCESS_PRIOR, AmplitudeLaw, law_for
+from .law import EXCESS_PRIOR, AmplitudeLaw
 from .read import Record, read_record
 from .units import degrees_read_as_rad
 
@@ -42,6 +52,8 @@ CONSISTENCY = 0.99  # chi^2 quantile above which the trials are called inconsist
 HALVES_Z = 3.0  # halves further apart than this many sigmas: flagged
 SUSPECT_TORSION = 0.5 * math.pi  # a torsion beyond this is rare enough to say so (rad)
 _DEGREE = math.pi / 180.0
+# Below this amplitude (rad) the series law's O(A^4) error, ~s^2 A^4, is under 1e-6: no quintic.
+_MATCH_FROM = 0.1
 
 
 @dataclass(frozen=True)
@@ -148,6 +160,24 @@ def _fit(record: Record, law: AmplitudeLaw, options: RecordOptions, deadline: De
         raise RigError(record.source, record.column, band_problem(record, exc, options)) from None
     except ValueError as exc:  # a record the fit cannot use
         raise RigError(record.source, record.column, str(exc)) from None
+
+
+def law_for(rig: Rig, axis, amplitude: float | None = None, rest=None) -> AmplitudeLaw:
+    """The rig's own law about ``axis``: the exact 1-DOF torsion for the vertical axis of a symmetric
+    rig, else the Kane model's period-amplitude series at the rig's moment, right at O(A^2); with the
+    record's largest ``amplitude`` (rad) its quintic is matched to the Kane model's T(A) / T0 there
+    (:meth:`AmplitudeLaw.matched`). ``rest``: the rig's rest pose if known (it does not depend on the
+    inertia)."""
+    if np.allclose(axis_vector(axis), AXES["z"]):
+        try:
+            return AmplitudeLaw.torsion(lagrange.from_rig(rig))
+        except RigError:
+            pass  # not a symmetric torsion: the Kane series below
+    law = AmplitudeLaw("series", s=amplitude_coefficient(rig, axis, rest))
+    if amplitude is not None and amplitude > _MATCH_FROM:
+        omega = 2.0 * math.pi / linear_period(rig, axis, rest)
+        law = law.matched(amplitude, amplitude_ratio(rig, axis, amplitude, rest), omega)
+    return law
 
 
 def _law_at(rig: Rig, axis, fit: OscillationFit, ideal: AmplitudeLaw, p: Pencil) -> AmplitudeLaw:

@@ -6,7 +6,8 @@ The rig file's optional ``[air]`` table (docs/air.md) gives the fluid (``density
 replaced by its inscribed ellipsoid, MuJoCo's convention for a box geom), centred at ``center`` (body
 frame, m) with its axes turned by the rotation vector ``rotation`` (body frame, rad). Optional:
 ``drag = [blunt, slender, angular]`` (MuJoCo's coefficients, default its 0.5, 0.25, 1.5) and
-``added_std`` (relative standard deviation of the added inertia, default 0).
+``added_std`` (relative standard deviation of the added inertia, default 0). It is read with the rig file
+(``Rig.air``) and used by the motion kernels, so it lives with the rig, below them.
 
 Added mass (Lamb, Hydrodynamics 6th ed. 1932, §114-115 and §121; Tuckerman, NACA Report 210, 1925):
 with semi-axes (a, b, c) and Lamb's coefficients alpha0 = a b c int_0^inf dl / ((a^2 + l) D),
