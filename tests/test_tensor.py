@@ -168,8 +168,9 @@ def test_a_hanging_at_an_amplitude_is_identify_s_moment(tmp_path):
     amplitude once, by the law of the rig hung with the start tensor, where identify() iterates J =
     invert(T / ratio(J)): the moments differed by ~1e-6. Now the tensor iterates the same fixed point:
     from the Kane model's periods of the true tensor it comes back to rounding, and each hanging's
-    moment about its vertical is identify()'s for its rig, period and amplitude to 1e-12 (both fixed
-    points stopped at 1e-11 steps, which leave ~1e-13)."""
+    moment about its vertical is identify()'s for its rig, period and amplitude to 1e-11 (identify()
+    stops at a 1e-9 step, which leaves ~4e-12: tighter, its simulated ratio's own step-size noise keeps
+    some rigs from converging)."""
     amplitude = 0.3
     wires = "".join(f"[[wire]]\nanchor = {w.anchor.tolist()}\nattach = {w.attach.tolist()}\nlength = {w.length!r}\n"
                     for w in rig("trifilar").wires)
@@ -189,7 +190,7 @@ def test_a_hanging_at_an_amplitude_is_identify_s_moment(tmp_path):
         hung, _ = mounted(e, fitted, TRUE_COM)
         vertical = _vertical(hung)
         assert identify(hung, vertical, period, amplitude).moment == pytest.approx(vertical @ hung.inertia @ vertical,
-                                                                                   rel=1e-12)
+                                                                                   rel=1e-11)
 
 
 @pytest.mark.slow

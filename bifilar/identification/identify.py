@@ -61,7 +61,7 @@ _MAX_STEPS = 2 * int(_REACH / _STEP)  # enough to cross the search range twice a
 _TOL = 1e-13  # |ln T - ln T_measured| at the root: rounding of a small eigenproblem
 _ROUNDING = 1e3 * np.finfo(float).eps  # eigh's absolute error on w2, relative to the largest w2
 # Amplitude correction: the fixed point J -> J(T / ratio(J)) contracts by ~A^2 per pass.
-_AMPLITUDE_RTOL = 1e-11  # the step left after it: ~1e-2 of it (contraction A^2 x d ln R / d ln J), ~1e-13
+_AMPLITUDE_RTOL = 1e-9
 _AMPLITUDE_PASSES = 8
 _CYCLES = 8  # periods simulated to measure T(A): crossing times fitted over 8 cycles
 _SAMPLES_PER_PERIOD = 100  # crossing refinement is good to ~1e-10 of the period at this rate
