@@ -1,6 +1,7 @@
 """The parallel-axis theorem (bifilar.identification.transfer) against the tensor summed point by point."""
 
 import numpy as np
+import pytest
 
 from bifilar.identification.transfer import object_part, parallel_axis, parallel_axis_moment
 
@@ -23,8 +24,8 @@ def test_parallel_axis_is_the_point_sum_moved():
     np.testing.assert_allclose(moved, about_origin, rtol=0, atol=1e-13 * np.abs(about_origin).max())
     e = rng.normal(size=3)
     e /= np.linalg.norm(e)
-    assert parallel_axis_moment(masses.sum(), com, e) == np.float64(e @ parallel_axis(masses.sum(), com) @ e) or \
-        abs(parallel_axis_moment(masses.sum(), com, e) - e @ parallel_axis(masses.sum(), com) @ e) < 1e-14
+    assert parallel_axis_moment(masses.sum(), com, e) == pytest.approx(e @ parallel_axis(masses.sum(), com) @ e,
+                                                                       rel=0, abs=1e-14)
 
 
 def test_object_part_is_the_assembly_less_the_fixture():

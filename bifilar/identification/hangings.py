@@ -36,7 +36,7 @@ from bifilar.rig.file import rig_from_dict
 from bifilar.rig.ranges import MAX_PERIOD_SIGMA, MAX_RELATIVE_SIGMA, rig_size
 from bifilar.rig.statics import rest_pose
 
-from .identify import _AMPLITUDE_PASSES, _AMPLITUDE_RTOL, amplitude_ratio, invert_period
+from .identify import AMPLITUDE_PASSES, AMPLITUDE_RTOL, amplitude_ratio, invert_period
 from .records.law import EXCESS_PRIOR
 from .records.pipeline import RecordOptions, identify_records
 from .tensor import Hanging, Tare, Tensor, identify_tensor, tensor_of
@@ -125,7 +125,8 @@ def read_hangings(path: str | Path) -> Setup:
     tare_of = [keys.index(e.tare.key) if e.tare else None for e in entries]
     hangings = _hangings(entries, held, measured, start, tare_of)
     if any(e.amplitude > 0.0 and not e.signals for e in entries):
-        start, measured, hangings = _amplitude_fixed_point(entries, held, measured, start, tares, tare_of, src)
+        start, measured, hangings = _amplitude_fixed_point(entries, held, measured, hangings, start, tares, tare_of,
+                                                           src)
     flags = [f"{e.label}: {flag}" for e, m in zip(entries, measured) for tr in m.trials for flag in tr.flags]
     flags += [f"tare {f.rig.source}: {flag}" for f in fixtures.values() for tr in f.measured.trials for flag in tr.flags]
     flags += [f"tare {f.rig.source}: I_{'xy'[i]}{'xy'[i]} is nan there: taken as a flat platform's, I_zz / 2"
@@ -140,23 +141,23 @@ def _hangings(entries: list[_Entry], held: list[np.ndarray], measured: list[Meas
             for e, h, m, t in zip(entries, held, measured, tare_of)]
 
 
-def _amplitude_fixed_point(entries, held, measured, x, tares, tare_of, src):
+def _amplitude_fixed_point(entries, held, measured, hangings, x, tares, tare_of, src):
     """:func:`bifilar.identification.identify.identify`'s fixed point J = invert(T / ratio(J)), for the
     tensor: a period given at an amplitude is taken to zero amplitude by the law of the rig hung with
     the fitted tensor, and the tensor refitted, until it moves by under the identify's tolerance (a
     pass contracts the change by ~A^2). Without it the law was the start tensor's, and a hanging's
     moment differed from identify's for the same rig, period and amplitude by ~1e-6 at 0.3 rad.
-    Records are left as measured: their fit learns the law's excess from the record itself."""
-    hangings = _hangings(entries, held, measured, x, tare_of)
-    for _ in range(_AMPLITUDE_PASSES):
+    Records are left as measured: their fit learns the law's excess from the record itself. ``hangings``:
+    as hung with ``x``."""
+    for _ in range(AMPLITUDE_PASSES):
         fitted = identify_tensor(hangings, x, tares, src).inertia
         measured = [_measure(e, h, fitted) if e.amplitude > 0.0 and not e.signals else m
                     for e, h, m in zip(entries, held, measured)]
         hangings = _hangings(entries, held, measured, fitted, tare_of)
-        if np.abs(fitted - x).max() <= _AMPLITUDE_RTOL * np.abs(fitted).max():
+        if np.abs(fitted - x).max() <= AMPLITUDE_RTOL * np.abs(fitted).max():
             return fitted, measured, hangings
         x = fitted
-    raise RigError(src, "hanging", f"the amplitude correction did not converge in {_AMPLITUDE_PASSES} passes")
+    raise RigError(src, "hanging", f"the amplitude correction did not converge in {AMPLITUDE_PASSES} passes")
 
 
 def fit_hangings(setup: Setup, source: str) -> Tensor:

@@ -61,8 +61,8 @@ _MAX_STEPS = 2 * int(_REACH / _STEP)  # enough to cross the search range twice a
 _TOL = 1e-13  # |ln T - ln T_measured| at the root: rounding of a small eigenproblem
 _ROUNDING = 1e3 * np.finfo(float).eps  # eigh's absolute error on w2, relative to the largest w2
 # Amplitude correction: the fixed point J -> J(T / ratio(J)) contracts by ~A^2 per pass.
-_AMPLITUDE_RTOL = 1e-9
-_AMPLITUDE_PASSES = 8
+AMPLITUDE_RTOL = 1e-9
+AMPLITUDE_PASSES = 8
 _CYCLES = 8  # periods simulated to measure T(A): crossing times fitted over 8 cycles
 _SAMPLES_PER_PERIOD = 100  # crossing refinement is good to ~1e-10 of the period at this rate
 # Integrator tolerance: the angles are O(1) rad, so the local error rtol is an error of rtol / A
@@ -312,10 +312,10 @@ def identify(rig: Rig, axis, period: float, amplitude: float = 0.0, rest: Rest |
     result = invert_period(rig, axis, period, rest, p)
     if amplitude == 0.0:
         return result
-    for _ in range(_AMPLITUDE_PASSES):
+    for _ in range(AMPLITUDE_PASSES):
         ratio = amplitude_ratio(result.rig, axis, amplitude, rest)
         new = invert_period(rig, axis, period / ratio, rest, p)
-        done = abs(new.moment / result.moment - 1.0) < _AMPLITUDE_RTOL
+        done = abs(new.moment / result.moment - 1.0) < AMPLITUDE_RTOL
         result = replace(new, amplitude_ratio=ratio)
         if done:
             return result

@@ -134,7 +134,7 @@ class AmplitudeLaw:
         w2 = omega * omega
         if self.kind == "exact":
             half, co = np.sin(0.5 * theta), np.cos(0.5 * theta)
-            r = np.sqrt(np.maximum(1.0 - self.rho * half * half, 1e-12))
+            r = self._r(theta)
             u = 2.0 * half * co / r  # sin(theta) / r
             v = (1.0 - 2.0 * half * half) / r + 0.25 * self.rho * u * u / r  # cos(theta) / r + ...
             return -w2 * u * (1.0 + self.lam * v * rate * rate) / (1.0 + self.lam * w2 * u * u)
@@ -171,7 +171,7 @@ class AmplitudeLaw:
         return Table(amps, 2.0 * quarter / math.pi)
 
     def _r(self, theta):
-        """r = sqrt(1 - rho sin^2(theta / 2)) of the exact law (floored like :meth:`acceleration`)."""
+        """r = sqrt(1 - rho sin^2(theta / 2)) of the exact law, floored at 1e-6 (the wires horizontal)."""
         return np.sqrt(np.maximum(1.0 - self.rho * np.sin(0.5 * theta) ** 2, 1e-12))
 
     def ratio(self, amplitude: float, omega: float) -> float:
