@@ -205,6 +205,7 @@ def test_hangings_from_records_and_a_tare_from_its_record(tmp_path, capsys):
     z = (np.array(report["tensor"]) - TRUE_INERTIA) / np.array(report["tensor_std"])
     assert np.abs(z).max() < 4.0, z
     assert all(h["period_source"] == "1 record(s)" for h in report["hangings"])
+    assert len(set(report["flags"])) == len(report["flags"])  # a flag of several records is said once
     # The tare from a 250 Hz gyro record of the disc alone (rad/s; a careful one: 0.3 rad, 40 cycles, no
     # other mode, since the object is 2 % of the disc's moment): its moment within 4 sigma of the disc's,
     # and the object's tensor from exact assembly periods within 4 of its sigmas.

@@ -36,6 +36,7 @@ from bifilar.rig.file import rig_from_dict
 from bifilar.rig.ranges import MAX_PERIOD_SIGMA, MAX_RELATIVE_SIGMA, rig_size
 from bifilar.rig.statics import rest_pose
 
+from .measurement import said_once, start_moment
 from .identify import AMPLITUDE_PASSES, AMPLITUDE_RTOL, amplitude_ratio, invert_period
 from .records.law import EXCESS_PRIOR
 from .records.pipeline import RecordOptions, identify_records
@@ -127,8 +128,11 @@ def read_hangings(path: str | Path) -> Setup:
     if any(e.amplitude > 0.0 and not e.signals for e in entries):
         start, measured, hangings = _amplitude_fixed_point(entries, held, measured, hangings, start, tares, tare_of,
                                                            src)
-    flags = [f"{e.label}: {flag}" for e, m in zip(entries, measured) for tr in m.trials for flag in tr.flags]
-    flags += [f"tare {f.rig.source}: {flag}" for f in fixtures.values() for tr in f.measured.trials for flag in tr.flags]
+    # a record's flag is said once for every record it applies to (30 records of one rig share most)
+    said = [(f"{e.label} {name}", what) for e, m in zip(entries, measured) for tr in m.trials for name, what in tr.said]
+    said += [(f"tare {f.rig.source} {name}", what) for f in fixtures.values() for tr in f.measured.trials
+             for name, what in tr.said]
+    flags = said_once(said)
     flags += [f"tare {f.rig.source}: I_{'xy'[i]}{'xy'[i]} is nan there: taken as a flat platform's, I_zz / 2"
               for f in fixtures.values() for i in f.assumed]
     return Setup(hangings, tares, list(fixtures.values()), measured, start, mass, com, flags)
@@ -376,8 +380,9 @@ def _fixture_rig(data: dict, src: str) -> tuple[Rig, list[int]]:
     nan = [i for i in range(3) if isinstance(cells[i][i], float) and math.isnan(cells[i][i])]
     if nan:
         mass = positive(required(body, "mass", src, "body."), src, "body.mass")
-        known = [number(cells[i][i], src, f"body.inertia[{i}]") for i in (0, 1) if i not in nan]
-        zz = cells[2][2] if 2 not in nan else (sum(known) / len(known) if known else _PLACEHOLDER * mass)
+        diagonal = np.diag([math.nan if i in nan else number(cells[i][i], src, f"body.inertia[{i}]") for i in (0, 1)]
+                           + [0.0])
+        zz = cells[2][2] if 2 not in nan else (start_moment(diagonal, 2) or _PLACEHOLDER * mass)
         for i in nan:
             cells[i][i] = zz if i == 2 else 0.5 * number(zz, src, "body.inertia[2]")
         body["inertia"] = cells

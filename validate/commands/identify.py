@@ -36,6 +36,7 @@ from __future__ import annotations
 
 import json
 import math
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -47,8 +48,8 @@ from bifilar.identification.records.law import EXCESS_PRIOR
 from ..argtypes import UsageError, bounded_float, positive_float, whole_number
 from ..statuses import RunFailed
 
-AXIS_INDEX = {"x": 0, "y": 1, "z": 2}
-WEAK_SENSITIVITY = 0.02  # d ln T / d ln I below this: the period barely depends on the moment
+if TYPE_CHECKING:
+    from bifilar.identification.measurement import Measurement, ObjectMoment
 
 
 def add_parser(subparsers) -> None:
@@ -103,17 +104,17 @@ def add_parser(subparsers) -> None:
 
 def run(args) -> int:
     """Identify, propagate, check and print; returns the exit status (errors raised for cli.main)."""
+    from bifilar.identification.measurement import subtract_tare
+
     _check_options(args)
     try:
-        report, trials = _identify(args.rig, args, args.period, args.signal)
+        result = _measure(args.rig, args, args.period, args.signal, args.amplitude)
         if args.tare:
-            fixture, tare_trials = _identify(args.tare, args, args.tare_period, args.tare_signal, amplitude=None)
-            report["tare"] = fixture
-            report["object"] = _transfer(args, report, fixture)
-            trials = trials + tare_trials
+            result = subtract_tare(result, _measure(args.tare, args, args.tare_period, args.tare_signal, None))
     except WorkSpent as exc:
         raise RunFailed(f"{exc} (--max-seconds {args.max_seconds:g}): give more, or a shorter record "
                         "(--from, --to)") from None
+    trials = result.trials + (result.tare.trials if result.tare else ())
     if args.png and trials:
         from ..report.identify_png import draw
 
@@ -121,15 +122,31 @@ def run(args) -> int:
     if args.html:
         from ..report.identify_page import write_identify_html
 
-        write_identify_html(args.html, report, trials, args)
+        write_identify_html(args.html, result, args)
     if args.json:
-        print(json.dumps(_clean(report), allow_nan=False))
+        print(json.dumps(_clean(result.as_dict()), allow_nan=False))
         return 0
-    _print(report)
+    _print(result)
     if args.tare:
-        _print(report["tare"], "fixture")
-        _print_object(report["object"], args.axis)
+        _print(result.tare, "fixture")
+        _print_object(result.object_part, args.axis)
     return 0
+
+
+def _measure(path: str, args, period, signals, amplitude) -> Measurement:
+    """:func:`bifilar.identification.measurement.measure` of one rig file (the rig, or a --tare fixture)."""
+    from bifilar.identification.measurement import measure
+
+    rig = load_rig(path, free_moment="xyz".index(args.axis))
+    if signals is not None:
+        return measure(rig, args.axis, signals=signals, options=_record_options(args), samples=args.samples)
+    try:
+        return measure(rig, args.axis, period=period, amplitude=amplitude, samples=args.samples)
+    except RigError as exc:
+        if exc.field == "period":
+            option = "--period" if path == args.rig else "--tare-period"
+            raise UsageError(f"identify: {option}: {exc.problem}") from None
+        raise
 
 
 def _check_options(args) -> None:
@@ -162,153 +179,6 @@ def _check_options(args) -> None:
         raise UsageError("identify: --tare-period and --tare-signal go with --tare")
 
 
-def _start_value(rig, axis: str):
-    """The rig with a nan moment replaced by a start value (the mean of the other two diagonal
-    entries: positive, and inside the triangle inequality of a diagonal tensor), and whether it was nan."""
-    from bifilar.identification.identify import with_moment
-
-    k = AXIS_INDEX[axis]
-    if not math.isnan(rig.inertia[k, k]):
-        return rig, False
-    inertia = np.where(np.isnan(rig.inertia), 0.0, rig.inertia)
-    others = [inertia[i, i] for i in range(3) if i != k]
-    from dataclasses import replace
-
-    return with_moment(replace(rig, inertia=inertia), axis, 0.5 * sum(others)), True
-
-
-def _identify(path: str, args, period, signals, amplitude="args"):
-    """(report dict, trials) for one rig file (the rig, or a --tare fixture)."""
-    from bifilar.identification.air import vacuum, without_air
-    from bifilar.identification.identify import axis_vector, identify, pencil, with_moment
-    from bifilar.identification.records.pipeline import identify_records
-
-    axis = args.axis
-    amplitude = args.amplitude if amplitude == "args" else amplitude
-    rig_in_air, was_nan = _start_value(load_rig(path, free_moment=AXIS_INDEX[axis]), axis)
-    rig = vacuum(rig_in_air)  # the moment identified is the apparent one, the air's included
-    flags = []
-    trials = []
-    p = pencil(rig, axis)  # the rig's one rest-pose search: everything below is about this rest pose
-    if signals is None:
-        try:
-            found = identify(rig, axis, period, amplitude or 0.0, p.lin.rest)
-        except RigError as exc:
-            if exc.field == "period":
-                option = "--period" if path == args.rig else "--tare-period"
-                raise UsageError(f"identify: {option}: {exc.problem}") from None
-            raise
-        ratio, small = found.amplitude_ratio, period / found.amplitude_ratio
-        small_std = rig.uncertainty.period / ratio
-        period_std_source = ("the rig file's [uncertainty].period" if small_std > 0.0 else
-                             "none: the rig file states no [uncertainty].period")
-        pooled = None
-    else:
-        trials, pooled = identify_records(rig, axis, signals, _record_options(args), p)
-        small, small_std, ratio = pooled.period, pooled.period_std, 1.0
-        period_std_source = "the records' fits"
-        for tr in trials:
-            flags.extend(tr.flags)
-        if not pooled.consistent:
-            flags.append(f"the {len(trials)} trials scatter more than their stated sigmas (chi^2 per degree of "
-                         f"freedom {pooled.chi2_per_dof:.3g}): the pooled sigma is scaled by its square root")
-    report = _propagate(rig, axis, small, small_std, args.samples, flags, p)
-    report["period_std_source"] = period_std_source
-    report["start_value"] = "nan in the rig file" if was_nan else "the rig file's value (a start only)"
-    if pooled is None:
-        report.update({key: None for key in _PER_RECORD}, trials=[], between_trial_std=None, chi2_per_dof=None)
-        report["amplitude"] = [amplitude, amplitude] if amplitude else None
-        if ratio != 1.0:
-            report["timed_period"] = period
-    else:
-        report["trials"] = [_trial(tr, rig.mass) for tr in trials]
-        one = report["trials"][0] if len(trials) == 1 else None
-        for key in _PER_RECORD:  # one record: its own fields at the top as well
-            report[key] = one[key] if one else None
-        report["between_trial_std"] = pooled.between_trial_std
-        report["chi2_per_dof"] = pooled.chi2_per_dof
-    report["rig"] = rig.name
-    if rig_in_air.air is not None:  # the body's own moment: the air's added moment subtracted
-        own = without_air(rig_in_air, axis_vector(axis), report["inertia"], report["std"] or 0.0)
-        report.update(inertia_without_air=own.inertia, inertia_without_air_std=own.std, air_share=own.air_share)
-        # The air is no rigid body: the apparent tensor may break the triangle inequality; the body's must not.
-        report["tensor_check_without_air"] = check = _tensor_check(with_moment(rig, axis, own.inertia).inertia)
-        if check["positive_definite"] and check["triangle"]:
-            report["flags"] = [f for f in report["flags"] if not f.startswith("the identified tensor")]
-    return report, trials
-
-
-def _propagate(rig, axis: str, period: float, period_std: float, samples, flags: list, p) -> dict:
-    """The propagated moment and everything derived from it (per mass, checks, flags); ``p`` is the
-    rig's pencil about ``axis`` (its rest pose and linearisation)."""
-    from bifilar.identification.identify import invert_period, with_moment
-    from bifilar.identification.propagation import budget, linear_axes, monte_carlo
-
-    found = invert_period(rig, axis, period, p.lin.rest, p)
-    geometry = [g for g in ("length", "anchor", "attach", "mass", "com") if getattr(rig.uncertainty, g) > 0.0]
-    if samples and (geometry or period_std > 0.0):
-        result = monte_carlo(rig, axis, period, period_std, samples, np.random.default_rng(0))
-    else:
-        result = linear_axes(rig, {axis: period}, period_std, p.lin.rest, {axis: found}, p.lin)[axis]
-    j, m = result.moment, found.rig.mass
-    inp = result.inputs
-    parts = (result.gradient * inp.std) ** 2
-    groups = np.array(inp.groups)
-    rep_var, rig_var = float(parts[groups == "period"].sum()), float(parts[groups != "period"].sum())
-    # J / m: the same inputs; the mass enters as d(J/m)/dm = (dJ/dm)/m - J/m^2
-    per_mass_gradient = result.gradient / m
-    per_mass_gradient[groups == "mass"] -= j / m**2
-    std_pm = float(np.sqrt(np.sum((per_mass_gradient * inp.std) ** 2)))
-    propagated = bool(np.any(inp.std > 0.0))
-    if not geometry:
-        flags.append("the rig file has no [uncertainty] for geometry or mass: nothing of the rig was propagated"
-                     + ("" if period_std > 0.0 else ", nor of the period: no uncertainty is stated"))
-    floor = p.floor
-    if propagated and result.low <= max(floor, 0.0):
-        flags.append(f"the 95 % interval reaches {result.low:.6g} kg m^2, a moment no body has (the tensor is "
-                     f"positive definite only above {max(floor, 0.0):.6g}): this rig cannot determine it")
-    check = _tensor_check(with_moment(rig, axis, j).inertia)
-    if not check["positive_definite"] or not check["triangle"]:
-        flags.append(f"the identified tensor (principal moments {', '.join(f'{x:.6g}' for x in check['principal'])}) "
-                     f"{'is not positive definite' if not check['positive_definite'] else 'breaks the triangle inequality'}: "
-                     "no body has it (a wrong period, mode or rig file)")
-    if found.sensitivity < WEAK_SENSITIVITY:
-        flags.append(f"the period hardly depends on this moment (d ln T / d ln I = {found.sensitivity:.3g}): "
-                     "its uncertainty is amplified 1/(2 x that) times")
-    per_mass = j / m
-    k = math.sqrt(per_mass) if per_mass > 0.0 else None
-    return {
-        "axis": axis,
-        "inertia": j,
-        "std": result.std if propagated else None,
-        "interval95": [result.low, result.high] if propagated else None,
-        "std_repeatability": math.sqrt(rep_var) if period_std > 0.0 else None,
-        "std_rig": math.sqrt(rig_var) if geometry else None,
-        "period": period,
-        "period_std": period_std if period_std > 0.0 else None,
-        "sensitivity": found.sensitivity,
-        "inertia_per_mass": per_mass,
-        "std_per_mass": std_pm if propagated else None,
-        "radius_of_gyration": k,
-        "radius_of_gyration_std": std_pm / (2.0 * k) if propagated and k else None,
-        "method": result.method,
-        "budget": result.budget if propagated else None,
-        "budget_per_mass": budget(inp, per_mass_gradient) if propagated else None,
-        "tensor_check": check,
-        "flags": flags,
-    }
-
-
-def _tensor_check(inertia: np.ndarray) -> dict:
-    """Positive definite, and the triangle inequality of the principal moments (to rounding)."""
-    principal = np.linalg.eigvalsh(inertia)
-    return {"principal": principal.tolist(), "positive_definite": bool(principal[0] > 0.0),
-            "triangle": bool(principal[0] + principal[1] >= principal[2] * (1.0 - 1e-9))}
-
-
-_PER_RECORD = ("amplitude", "damping", "law", "halves", "rejected", "residual_rms", "outliers")
-
-
 def _record_options(args):
     """identify's record options as the pipeline takes them."""
     from bifilar.identification.records.pipeline import RecordOptions
@@ -316,68 +186,6 @@ def _record_options(args):
     return RecordOptions(args.column, args.kind, args.time_column, args.fps, args.time_unit, args.angle_unit,
                          args.start, args.end, EXCESS_PRIOR if args.law_sigma is None else args.law_sigma,
                          args.amplitude_scale, args.max_amplitude, args.max_seconds)
-
-
-def _trial(tr, mass: float) -> dict:
-    """The JSON object of one trial: its fit and the moment from it alone (repeatability sigma)."""
-    fit = tr.fit
-    z = 1.959963984540054
-    halves = None
-    if tr.halves is not None:
-        h = tr.halves
-        halves = {"first": {"period": h.first[0], "period_std": h.first[1]},
-                  "second": {"period": h.second[0], "period_std": h.second[1]}, "split": h.split, "z": h.z}
-    return {
-        "source": tr.record.source,
-        "period": fit.period,
-        "period_std": fit.period_std,
-        "period_std_statistical": fit.period_std_statistical,
-        "period_std_law": fit.period_std_law,
-        "period_std_white": fit.period_std_white,
-        "inertia": tr.moment,
-        "std": tr.moment_std,
-        "interval95": [tr.moment - z * tr.moment_std, tr.moment + z * tr.moment_std],
-        "inertia_per_mass": tr.moment / mass,
-        "std_per_mass": tr.moment_std / mass,
-        "amplitude": list(fit.amplitude) if fit.amplitude is not None else None,
-        "damping": fit.damping,
-        "law": fit.law.as_dict(),
-        "halves": halves,
-        "rejected": fit.rejected.as_dict(),
-        "residual_rms": fit.rms,
-        "outliers": fit.outliers.tolist(),
-        "second_mode": None if fit.second_mode is None else dict(zip(("period", "amplitude", "decay"), fit.second_mode)),
-        "samples": fit.samples,
-        "binned": fit.binned,
-        "cycles": fit.cycles,
-        "dropped": tr.record.dropped,
-        "unfolded": tr.record.unfolded,
-        "block": fit.block,
-        "jackknife": fit.jackknife,
-        "flags": list(tr.flags),
-    }
-
-
-def _transfer(args, report: dict, fixture: dict) -> dict:
-    """The object's own moment: (rig - fixture, both about the axis through their own COM) by the
-    parallel-axis theorem, with the two sigmas combined as independent (conservative: the shared
-    geometry errors correlate and partly cancel)."""
-    from bifilar.identification.identify import axis_vector
-    from bifilar.identification.transfer import object_part, parallel_axis_moment
-
-    rig, fix = load_rig(args.rig, AXIS_INDEX[args.axis]), load_rig(args.tare, AXIS_INDEX[args.axis])
-    e = axis_vector(args.axis)
-    if rig.mass - fix.mass <= 0.0:
-        raise RigError(args.tare, "body.mass", f"{fix.mass:g} kg: not less than the rig's {rig.mass:g} kg, so no "
-                                               "object is left")
-    m_obj, c_obj = object_part(rig.mass, rig.com, fix.mass, fix.com)
-    about_com = report["inertia"] - (fixture["inertia"] + parallel_axis_moment(fix.mass, fix.com - rig.com, e))
-    own = about_com - parallel_axis_moment(m_obj, c_obj - rig.com, e)
-    stds = [report["std"], fixture["std"]]
-    std = math.sqrt(sum(s**2 for s in stds)) if all(s is not None for s in stds) else None
-    return {"mass": m_obj, "com": c_obj.tolist(), "inertia": own, "std": std,
-            "interval95": [own - 1.96 * std, own + 1.96 * std] if std is not None else None,
-            "inertia_per_mass": own / m_obj, "flags": [] if own > 0 else ["the object's moment is not positive"]}
 
 
 def _clean(value):
@@ -404,45 +212,45 @@ def _say(text: str, indent: int = 2) -> None:
                         break_on_hyphens=False, break_long_words=False))
 
 
-def _print(report: dict, label: str | None = None) -> None:
-    a, unit = report["axis"], "kg m^2"
-    name = f"rig {report['rig']}" + (f" ({label})" if label else "")
-    if report["std"] is None:
-        _say(f"{name}: I_{a}{a} = {report['inertia']:.9g} {unit} (no uncertainty propagated)", 0)
+def _print(result: Measurement, label: str | None = None) -> None:
+    a, unit = result.axis, "kg m^2"
+    name = f"rig {result.rig}" + (f" ({label})" if label else "")
+    if result.std is None:
+        _say(f"{name}: I_{a}{a} = {result.inertia:.9g} {unit} (no uncertainty propagated)", 0)
     else:
-        low, high = report["interval95"]
-        _say(f"{name}: I_{a}{a} = {report['inertia']:.9g} +- {report['std']:.3g} {unit} "
-             f"(95 %: {low:.9g} .. {high:.9g}; {report['method']})", 0)
-    parts = [f"{label} {report[key]:.3g}" for key, label in (("std_repeatability", "repeatability"),
-                                                             ("std_rig", "rig geometry and mass")) if report[key]]
+        low, high = result.interval95
+        _say(f"{name}: I_{a}{a} = {result.inertia:.9g} +- {result.std:.3g} {unit} "
+             f"(95 %: {low:.9g} .. {high:.9g}; {result.method})", 0)
+    parts = [f"{what} {std:.3g}" for std, what in ((result.std_repeatability, "repeatability"),
+                                                  (result.std_rig, "rig geometry and mass")) if std]
     if parts:
         _say("sigma: " + ", ".join(parts) + f" {unit}")
-    per = report["inertia_per_mass"]
-    spm = report["std_per_mass"]
-    _say(f"I/m = {per:.9g}" + (f" +- {spm:.3g}" if spm is not None else "") + " m^2, radius of gyration "
-         f"{report['radius_of_gyration']:.6g} m")
-    std = report["period_std"]
-    _say(f"period (zero amplitude) {report['period']:.9g}" + (f" +- {std:.3g}" if std else "") +
-         f" s ({report['period_std_source']}); d ln T / d ln I = {report['sensitivity']:.3g}")
-    if "air_share" in report:
-        _say(f"without the air: {report['inertia_without_air']:.9g} +- {report['inertia_without_air_std']:.3g} "
-             f"{unit} (the air is {100.0 * report['air_share']:.1f} % of the measured moment)")
-    if report["budget"]:
-        shares = sorted(report["budget"].items(), key=lambda kv: -kv[1])
+    spm = result.std_per_mass
+    _say(f"I/m = {result.inertia_per_mass:.9g}" + (f" +- {spm:.3g}" if spm is not None else "") + " m^2, radius of "
+         f"gyration {result.radius_of_gyration:.6g} m")
+    std = result.period_std
+    _say(f"period (zero amplitude) {result.period:.9g}" + (f" +- {std:.3g}" if std else "") +
+         f" s ({result.period_std_source}); d ln T / d ln I = {result.sensitivity:.3g}")
+    if result.air is not None:
+        _say(f"without the air: {result.air.inertia:.9g} +- {result.air.std:.3g} {unit} (the air is "
+             f"{100.0 * result.air.share:.1f} % of the measured moment)")
+    if result.budget:
+        shares = sorted(result.budget.items(), key=lambda kv: -kv[1])
         _say("variance budget: " + ", ".join(f"{g} {100.0 * s:.1f} %" for g, s in shares))
-        shares = sorted(report["budget_per_mass"].items(), key=lambda kv: -kv[1])
+        shares = sorted(result.budget_per_mass.items(), key=lambda kv: -kv[1])
         _say("variance budget of I/m: " + ", ".join(f"{g} {100.0 * s:.1f} %" for g, s in shares))
-    for i, tr in enumerate(report["trials"], start=1):
+    for i, tr in enumerate(result.trial_dicts(), start=1):
         _print_trial(i, tr)
-    if len(report["trials"]) > 1:
-        _say(f"between trials: std {report['between_trial_std']:.3g} {unit}, chi^2/dof {report['chi2_per_dof']:.3g}")
+    if len(result.trials) > 1:
+        _say(f"between trials: std {result.pooled.between_trial_std:.3g} {unit}, chi^2/dof "
+             f"{result.pooled.chi2_per_dof:.3g}")
     # with air, the body's own tensor is the one that must be a body's (the apparent one need not be)
-    check, whose = ((report["tensor_check_without_air"], " (the body's, without the air)")
-                    if "tensor_check_without_air" in report else (report["tensor_check"], ""))
-    _say(f"identified tensor{whose}: principal {', '.join(f'{x:.6g}' for x in check['principal'])}; positive "
-         f"definite {'yes' if check['positive_definite'] else 'NO'}, triangle inequality "
-         f"{'yes' if check['triangle'] else 'NO'}")
-    for flag in report["flags"]:
+    check, whose = ((result.air.tensor_check, " (the body's, without the air)") if result.air is not None else
+                    (result.tensor_check, ""))
+    _say(f"identified tensor{whose}: principal {', '.join(f'{x:.6g}' for x in check.principal)}; positive "
+         f"definite {'yes' if check.positive_definite else 'NO'}, triangle inequality "
+         f"{'yes' if check.triangle else 'NO'}")
+    for flag in result.flags:
         _say(f"warning: {flag}")
 
 
@@ -487,9 +295,9 @@ def _print_trial(i: int, tr: dict) -> None:
              f"{r['stuck']} stuck values; {tr['dropped']} rows had no value): {spans}", 4)
 
 
-def _print_object(obj: dict, axis: str) -> None:
-    std = f" +- {obj['std']:.3g}" if obj["std"] is not None else " (no uncertainty propagated)"
-    _say(f"object (rig minus fixture, {obj['mass']:.6g} kg at COM {', '.join(f'{x:.6g}' for x in obj['com'])} m): "
-         f"I_{axis}{axis} about its own COM = {obj['inertia']:.9g}{std} kg m^2", 0)
-    for flag in obj["flags"]:
+def _print_object(obj: ObjectMoment, axis: str) -> None:
+    std = f" +- {obj.std:.3g}" if obj.std is not None else " (no uncertainty propagated)"
+    _say(f"object (rig minus fixture, {obj.mass:.6g} kg at COM {', '.join(f'{x:.6g}' for x in obj.com)} m): "
+         f"I_{axis}{axis} about its own COM = {obj.inertia:.9g}{std} kg m^2", 0)
+    for flag in obj.flags:
         _say(f"warning: {flag}")

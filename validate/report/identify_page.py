@@ -3,19 +3,22 @@ warnings, each record's fit with its residuals and its period against amplitude 
 law, the variance budget, the check of the identified tensor, and the inputs (the options given and
 the rig files as read).
 
-Built from the command's report dict (the one ``--json`` prints, docs/identification.md) and its
-fitted trials (:class:`bifilar.identification.records.pipeline.Trial`), so the page shows what the command
-computed and nothing else.
+Built from the command's typed result (:class:`bifilar.identification.measurement.Measurement`, the one
+``--json`` prints as a dict, docs/identification.md) and its fitted trials, so the page shows what the
+command computed and nothing else.
 """
 
 from __future__ import annotations
 
-from collections.abc import Sequence
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from .html import Raw, join, number, table, tag
 from .page import Page, Section
 from .sections import Facts, Table, Text, Warnings, figure
+
+if TYPE_CHECKING:
+    from bifilar.identification.measurement import Measurement
 
 UNIT = "kg m^2"
 
@@ -27,35 +30,36 @@ def _pm(value, std, unit: str = "", digits: int = 9) -> str:
     return f"{text} {unit}".strip()
 
 
-def result_section(report: dict, title: str = "Result") -> Facts:
-    a = report["axis"]
-    items = [("rig", report["rig"]), (f"I_{a}{a}", _pm(report["inertia"], report["std"], UNIT))]
-    if report["interval95"]:
-        items.append(("95 % interval", f"{number(report['interval95'][0], 9)} .. {number(report['interval95'][1], 9)} "
-                                       f"{UNIT} ({report['method']})"))
-    items += [("sigma: repeatability", number(report["std_repeatability"], 3, UNIT)),
-              ("sigma: rig geometry and mass", number(report["std_rig"], 3, UNIT)),
-              ("I / m", _pm(report["inertia_per_mass"], report["std_per_mass"], "m^2")),
-              ("radius of gyration", _pm(report["radius_of_gyration"], report["radius_of_gyration_std"], "m", 6)),
-              ("period at zero amplitude", _pm(report["period"], report["period_std"], "s") +
-               f" ({report['period_std_source']})"),
-              ("d ln T / d ln I", number(report["sensitivity"], 4)),
-              ("start value", report["start_value"])]
-    if report.get("timed_period") is not None:
-        items.append(("period as timed", f"{number(report['timed_period'], 9)} s at amplitude "
-                                         f"{number(report['amplitude'][0], 4)} rad"))
-    if "air_share" in report:
-        items += [("without the air", _pm(report["inertia_without_air"], report["inertia_without_air_std"], UNIT)),
-                  ("the air's share", f"{100.0 * report['air_share']:.2f} % of the measured moment")]
-    if len(report["trials"]) > 1:
-        items.append(("between trials", f"std {number(report['between_trial_std'], 3, UNIT)}, chi^2 per degree "
-                                        f"of freedom {number(report['chi2_per_dof'], 3)}"))
+def result_section(result: Measurement, title: str = "Result") -> Facts:
+    a = result.axis
+    items = [("rig", result.rig), (f"I_{a}{a}", _pm(result.inertia, result.std, UNIT))]
+    if result.interval95:
+        items.append(("95 % interval", f"{number(result.interval95[0], 9)} .. {number(result.interval95[1], 9)} "
+                                       f"{UNIT} ({result.method})"))
+    items += [("sigma: repeatability", number(result.std_repeatability, 3, UNIT)),
+              ("sigma: rig geometry and mass", number(result.std_rig, 3, UNIT)),
+              ("I / m", _pm(result.inertia_per_mass, result.std_per_mass, "m^2")),
+              ("radius of gyration", _pm(result.radius_of_gyration, result.radius_of_gyration_std, "m", 6)),
+              ("period at zero amplitude", _pm(result.period, result.period_std, "s") +
+               f" ({result.period_std_source})"),
+              ("d ln T / d ln I", number(result.sensitivity, 4)),
+              ("start value", result.start_value)]
+    if result.timed_period is not None:
+        items.append(("period as timed", f"{number(result.timed_period, 9)} s at amplitude "
+                                         f"{number(result.amplitude[0], 4)} rad"))
+    if result.air is not None:
+        items += [("without the air", _pm(result.air.inertia, result.air.std, UNIT)),
+                  ("the air's share", f"{100.0 * result.air.share:.2f} % of the measured moment")]
+    if len(result.trials) > 1:
+        items.append(("between trials", f"std {number(result.pooled.between_trial_std, 3, UNIT)}, chi^2 per degree "
+                                        f"of freedom {number(result.pooled.chi2_per_dof, 3)}"))
     return Facts(title, items)
 
 
-def trials_table(report: dict) -> Raw:
+def trials_table(trials: list[dict]) -> Raw:
+    """The trials (their JSON objects, :meth:`Measurement.trial_dicts`) a row each."""
     rows = []
-    for i, tr in enumerate(report["trials"], start=1):
+    for i, tr in enumerate(trials, start=1):
         amp = tr["amplitude"]
         second = tr["second_mode"]
         rows.append((i, tr["source"], _pm(tr["period"], tr["period_std"], "s"), _pm(tr["inertia"], tr["std"], UNIT),
@@ -91,8 +95,9 @@ class FitSection(Section):
     title = "Fit"
     open = True
 
-    def __init__(self, report: dict, trials: Sequence):
-        self.report, self.trials = report, trials
+    def __init__(self, result: Measurement):
+        self.result = result
+        self.trials = result.trials + (result.tare.trials if result.tare else ())
 
     def body(self) -> str:
         if not self.trials:
@@ -101,26 +106,25 @@ class FitSection(Section):
 
         caption = ("each record with its fit (rejected samples marked), the residuals, and each cycle's period "
                    "against its amplitude beside the fitted law T0 (1 + s A^2)")
-        return join([figure(render(self.trials), caption), trials_table(self.report)])
+        return join([figure(render(self.trials), caption), trials_table(self.result.trial_dicts())])
 
 
-def budget_section(report: dict) -> Section:
-    if not report["budget"]:
+def budget_section(result: Measurement) -> Section:
+    if not result.budget:
         return Text("Variance budget", ["No uncertainty was propagated: nothing to share out."])
-    groups = sorted(report["budget"], key=lambda g: -report["budget"][g])
-    rows = [(g, f"{100.0 * report['budget'][g]:.2f} %", f"{100.0 * report['budget_per_mass'][g]:.2f} %")
-            for g in groups]
-    return Table("Variance budget", ("uncertainty group", f"share of var(I_{report['axis'] * 2})", "share of var(I / m)"),
+    groups = sorted(result.budget, key=lambda g: -result.budget[g])
+    rows = [(g, f"{100.0 * result.budget[g]:.2f} %", f"{100.0 * result.budget_per_mass[g]:.2f} %") for g in groups]
+    return Table("Variance budget", ("uncertainty group", f"share of var(I_{result.axis * 2})", "share of var(I / m)"),
                  rows, note="Each [uncertainty] group's share of the variance (the period group is the repeatability).")
 
 
-def tensor_section(report: dict) -> Table:
+def tensor_section(result: Measurement) -> Table:
     rows = []
-    for label, key in (("identified tensor", "tensor_check"), ("without the air", "tensor_check_without_air")):
-        check = report.get(key)
+    for label, check in (("identified tensor", result.tensor_check),
+                         ("without the air", result.air.tensor_check if result.air else None)):
         if check:
-            rows.append((label, ", ".join(number(x, 6) for x in check["principal"]),
-                         "yes" if check["positive_definite"] else "NO", "yes" if check["triangle"] else "NO"))
+            rows.append((label, ", ".join(number(x, 6) for x in check.principal),
+                         "yes" if check.positive_definite else "NO", "yes" if check.triangle else "NO"))
     return Table("Tensor check", ("tensor", f"principal moments ({UNIT})", "positive definite", "triangle inequality"),
                  rows, note="The rig file's tensor with the identified moment in place: a body's tensor is positive "
                             "definite and its principal moments obey the triangle inequality.",
@@ -147,28 +151,28 @@ class InputsSection(Section):
         return join(parts)
 
 
-def identify_page(report: dict, trials: Sequence, command: str, files: dict[str, str]) -> Page:
+def identify_page(result: Measurement, command: str, files: dict[str, str]) -> Page:
     """The page (see the module docstring); ``command`` the command line, ``files`` label -> rig file."""
-    a = report["axis"]
-    page = Page(f"identify {report['rig']}: I_{a}{a}", f"{_pm(report['inertia'], report['std'], UNIT)}")
-    flags = list(report["flags"])
-    page.add(result_section(report))
-    if "tare" in report:
-        obj = report["object"]
-        flags += [f"fixture: {f}" for f in report["tare"]["flags"]] + [f"object: {f}" for f in obj["flags"]]
-        page.add(result_section(report["tare"], "Fixture (tare)"), Facts("Object (rig minus fixture)", [
-            ("mass", number(obj["mass"], 6, "kg")),
-            ("COM (body frame)", ", ".join(number(x, 6) for x in obj["com"]) + " m"),
-            (f"I_{a}{a} about its own COM", _pm(obj["inertia"], obj["std"], UNIT))]))
-    page.add(Warnings("Warnings", flags), FitSection(report, trials), budget_section(report), tensor_section(report),
+    a = result.axis
+    page = Page(f"identify {result.rig}: I_{a}{a}", f"{_pm(result.inertia, result.std, UNIT)}")
+    flags = list(result.flags)
+    page.add(result_section(result))
+    if result.tare is not None:
+        obj = result.object_part
+        flags += [f"fixture: {f}" for f in result.tare.flags] + [f"object: {f}" for f in obj.flags]
+        page.add(result_section(result.tare, "Fixture (tare)"), Facts("Object (rig minus fixture)", [
+            ("mass", number(obj.mass, 6, "kg")),
+            ("COM (body frame)", ", ".join(number(x, 6) for x in obj.com) + " m"),
+            (f"I_{a}{a} about its own COM", _pm(obj.inertia, obj.std, UNIT))]))
+    page.add(Warnings("Warnings", flags), FitSection(result), budget_section(result), tensor_section(result),
              InputsSection(command, files))
     return page
 
 
-def write_identify_html(path: str | Path, report: dict, trials: Sequence, args) -> Path:
-    """Write the page of an ``identify`` run (its report dict, its trials and its ``args``) whole."""
+def write_identify_html(path: str | Path, result: Measurement, args) -> Path:
+    """Write the page of an ``identify`` run (its result and its ``args``) whole."""
     import shlex
 
     files = {"rig": args.rig, **({"fixture": args.tare} if args.tare else {})}
     command = "python -m validate " + shlex.join(getattr(args, "argv", ["identify", args.rig, "..."]))
-    return identify_page(report, trials, command, files).write(path)
+    return identify_page(result, command, files).write(path)

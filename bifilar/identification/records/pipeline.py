@@ -100,7 +100,13 @@ class Trial:
     moment: float
     moment_std: float
     sensitivity: float
-    flags: tuple[str, ...]
+    flags: tuple[str, ...]  # each "<record file name>: <what>"
+
+    @property
+    def said(self) -> list[tuple[str, str]]:
+        """The flags as (record file name, what) pairs."""
+        name = file_name(self.record)
+        return [(name, flag.removeprefix(f"{name}: ")) for flag in self.flags]
 
 
 @dataclass(frozen=True)
@@ -250,8 +256,13 @@ def _independent(fit: OscillationFit) -> float:
     return max(fit.period_std**2 - float(fit.prior_gain @ fit.prior_gain), fit.period_std_statistical**2)
 
 
+def file_name(record: Record) -> str:
+    """The record's file name without its folder: what its flags begin with."""
+    return record.source.rsplit("/", 1)[-1]
+
+
 def _flags(record: Record, fit: OscillationFit, halves: Halves | None, options: RecordOptions) -> list[str]:
-    name = record.source.rsplit("/", 1)[-1]
+    name = file_name(record)
     flags = []
     if fit.amplitude is not None and record.kind != "proportional" and fit.amplitude[0] > SUSPECT_TORSION:
         flags.append(f"{name}: a swing of {fit.amplitude[0]:.3g} rad is more than pi/2: check the angle unit")

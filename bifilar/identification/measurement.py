@@ -1,0 +1,374 @@
+"""One measured moment of inertia, as every face of the tool reports it: the library behind ``validate identify``.
+
+:func:`measure` takes a rig (the body as hung; the unknown moment may be ``nan``) and a period timed at
+an amplitude, or record files, and returns a frozen :class:`Measurement`: the moment about a body axis
+with its propagated sigma and the sigma's parts, the figures per unit mass, the variance budget, the
+check of the identified tensor, the records' trials and the flags. :func:`subtract_tare` turns the
+measurements of an assembly and of its fixture alone into the object's own moment
+(:class:`ObjectMoment`). ``as_dict()`` is the JSON object ``identify --json`` prints (its fields:
+docs/identification.md); the CLI, the HTML page and the tensor's hangings read the typed fields.
+
+The steps are those of docs/identification.md: a ``nan`` moment gets a start value (:func:`start_moment`),
+the air is left out of the model (the moment found is the apparent one), the rig is linearised once
+(:func:`bifilar.identification.identify.pencil`), the period is taken to zero amplitude (the amplitude
+law's fixed point for a timed period, the records' fits for records), inverted and propagated
+(:mod:`bifilar.identification.propagation`); with an ``[air]`` table the body's own moment is added.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from bifilar.rig import Rig, RigError
+
+from .air import vacuum, without_air
+from .identify import axis_vector, identify, invert_period, pencil, with_moment
+from .propagation import budget, linear_axes, monte_carlo
+from .records.pipeline import Pooled, RecordOptions, Trial, identify_records
+from .transfer import object_part, parallel_axis_moment
+
+AXIS_INDEX = {"x": 0, "y": 1, "z": 2}
+WEAK_SENSITIVITY = 0.02  # d ln T / d ln I below this: the period barely depends on the moment
+Z95 = 1.959963984540054  # the standard normal's 97.5 % point: a 95 % interval is +- Z95 sigma
+
+
+@dataclass(frozen=True)
+class TensorCheck:
+    """Whether a tensor (kg m^2) can be a body's: its principal moments (ascending), positive
+    definite, and the triangle inequality of the principal moments (to rounding)."""
+
+    principal: tuple[float, float, float]
+    positive_definite: bool
+    triangle: bool
+
+    @property
+    def body(self) -> bool:
+        """A body can have it."""
+        return self.positive_definite and self.triangle
+
+    def as_dict(self) -> dict:
+        return {"principal": list(self.principal), "positive_definite": self.positive_definite,
+                "triangle": self.triangle}
+
+
+def tensor_check(inertia: np.ndarray) -> TensorCheck:
+    """:class:`TensorCheck` of a 3x3 inertia tensor."""
+    principal = np.linalg.eigvalsh(inertia)
+    return TensorCheck(tuple(principal.tolist()), bool(principal[0] > 0.0),
+                       bool(principal[0] + principal[1] >= principal[2] * (1.0 - 1e-9)))
+
+
+@dataclass(frozen=True)
+class AirPart:
+    """The body's own moment (kg m^2) and sigma with the air's added moment taken out, the air's share
+    of the measured moment, and the check of the body's own tensor."""
+
+    inertia: float
+    std: float
+    share: float
+    tensor_check: TensorCheck
+
+
+@dataclass(frozen=True)
+class ObjectMoment:
+    """The object's own moment (kg m^2) about the axis through its own COM, from an assembly and its
+    fixture (:func:`subtract_tare`): mass (kg), COM (body frame, m), sigma (None if neither states one),
+    95 % interval, moment per unit mass (m^2) and flags."""
+
+    mass: float
+    com: tuple[float, float, float]
+    inertia: float
+    std: float | None
+    inertia_per_mass: float
+    flags: tuple[str, ...]
+
+    @property
+    def interval95(self) -> tuple[float, float] | None:
+        return None if self.std is None else (self.inertia - 1.96 * self.std, self.inertia + 1.96 * self.std)
+
+    def as_dict(self) -> dict:
+        return {"mass": self.mass, "com": list(self.com), "inertia": self.inertia, "std": self.std,
+                "interval95": None if self.interval95 is None else list(self.interval95),
+                "inertia_per_mass": self.inertia_per_mass, "flags": list(self.flags)}
+
+
+@dataclass(frozen=True)
+class Measurement:
+    """A moment of inertia (kg m^2) about the body axis ``axis`` of the rig named ``rig``.
+
+    ``std`` is the propagated standard deviation (None where nothing was: the rig file states no
+    sigma), ``std_repeatability`` its part from the period, ``std_rig`` from the rig's geometry and
+    mass; ``period`` (s) is the zero-amplitude period inverted, ``timed_period`` the one given at
+    ``amplitude`` (rad) where that differs; ``sensitivity`` is d ln T / d ln I. ``budget`` maps each
+    uncertainty group to its share of var(I) (``budget_per_mass``: of var(I / m)). ``trials`` are the
+    records' fits (empty for a period), ``pooled`` their pooled period. ``air`` is the body's own moment
+    where the rig has an ``[air]`` table. ``tare`` and ``object_part`` are set by :func:`subtract_tare`.
+    """
+
+    rig: str
+    source: str
+    axis: str
+    mass: float
+    com: tuple[float, float, float]
+    inertia: float
+    std: float | None
+    interval95: tuple[float, float] | None
+    std_repeatability: float | None
+    std_rig: float | None
+    period: float
+    period_std: float | None
+    period_std_source: str
+    sensitivity: float
+    inertia_per_mass: float
+    std_per_mass: float | None
+    radius_of_gyration: float | None
+    radius_of_gyration_std: float | None
+    method: str
+    budget: dict | None
+    budget_per_mass: dict | None
+    tensor_check: TensorCheck
+    flags: tuple[str, ...]
+    start_value: str
+    amplitude: tuple[float, float] | None = None  # a timed period's amplitude, twice (rad)
+    timed_period: float | None = None
+    trials: tuple[Trial, ...] = ()
+    pooled: Pooled | None = None
+    air: AirPart | None = None
+    tare: Measurement | None = None
+    object_part: ObjectMoment | None = None
+
+    def trial_dicts(self) -> list[dict]:
+        """Each trial as its JSON object (:func:`trial_dict`)."""
+        return [trial_dict(tr, self.mass) for tr in self.trials]
+
+    def as_dict(self) -> dict:
+        """The JSON object of ``identify --json``: numbers, lists, strings, None (non-finite numbers kept:
+        the writer maps them to null)."""
+        out = {"axis": self.axis, "inertia": self.inertia, "std": self.std,
+               "interval95": None if self.interval95 is None else list(self.interval95),
+               "std_repeatability": self.std_repeatability, "std_rig": self.std_rig, "period": self.period,
+               "period_std": self.period_std, "sensitivity": self.sensitivity,
+               "inertia_per_mass": self.inertia_per_mass, "std_per_mass": self.std_per_mass,
+               "radius_of_gyration": self.radius_of_gyration, "radius_of_gyration_std": self.radius_of_gyration_std,
+               "method": self.method, "budget": self.budget, "budget_per_mass": self.budget_per_mass,
+               "tensor_check": self.tensor_check.as_dict(), "flags": list(self.flags),
+               "period_std_source": self.period_std_source, "start_value": self.start_value}
+        trials = self.trial_dicts()
+        one = trials[0] if len(trials) == 1 else None
+        per_record = {key: one[key] if one else None for key in PER_RECORD}
+        if self.pooled is None:
+            per_record["amplitude"] = None if self.amplitude is None else list(self.amplitude)
+            out.update(per_record, trials=[], between_trial_std=None, chi2_per_dof=None)
+            if self.timed_period is not None:
+                out["timed_period"] = self.timed_period
+        else:
+            out.update(trials=trials, **per_record, between_trial_std=self.pooled.between_trial_std,
+                       chi2_per_dof=self.pooled.chi2_per_dof)
+        out["rig"] = self.rig
+        if self.air is not None:
+            out.update(inertia_without_air=self.air.inertia, inertia_without_air_std=self.air.std,
+                       air_share=self.air.share, tensor_check_without_air=self.air.tensor_check.as_dict())
+        if self.tare is not None:
+            out["tare"] = self.tare.as_dict()
+        if self.object_part is not None:
+            out["object"] = self.object_part.as_dict()
+        return out
+
+
+PER_RECORD = ("amplitude", "damping", "law", "halves", "rejected", "residual_rms", "outliers")  # one record's, on top
+
+
+def start_moment(inertia: np.ndarray, k: int) -> float | None:
+    """A start value for an unknown (``nan``) diagonal entry ``k`` of a tensor: the mean of the other
+    diagonal entries that are known (positive, and inside the triangle inequality of a diagonal tensor),
+    None if none is."""
+    known = [inertia[i, i] for i in range(3) if i != k and not math.isnan(inertia[i, i])]
+    return sum(known) / len(known) if known else None
+
+
+def _started(rig: Rig, axis: str) -> tuple[Rig, bool]:
+    """The rig with a ``nan`` moment about ``axis`` replaced by :func:`start_moment` (the tensor's other
+    ``nan`` entries read as 0), and whether it was ``nan``."""
+    k = AXIS_INDEX[axis]
+    if not math.isnan(rig.inertia[k, k]):
+        return rig, False
+    inertia = np.where(np.isnan(rig.inertia), 0.0, rig.inertia)
+    return with_moment(replace(rig, inertia=inertia), axis, start_moment(inertia, k)), True
+
+
+def measure(rig: Rig, axis: str, *, period: float | None = None, amplitude: float | None = None,
+            signals: Sequence | None = None, options: RecordOptions = RecordOptions(),
+            samples: int | None = None) -> Measurement:
+    """The moment about body axis ``axis`` (``x``, ``y`` or ``z``) from a ``period`` (s) timed at peak
+    rotation ``amplitude`` (rad; None or 0: small), or from ``signals`` (record files, or records
+    already read: trials of this rig, pooled), with the rig's ``[uncertainty]`` propagated linearly or,
+    with ``samples``, by that many Monte Carlo draws.
+
+    Raises :class:`RigError` for a period no moment gives (field ``period``) and for records that cannot
+    be used, :class:`bifilar.identification.records.bounds.WorkSpent` once ``options.max_seconds`` is spent.
+    """
+    rig_in_air, was_nan = _started(rig, axis)
+    rig = vacuum(rig_in_air)  # the moment identified is the apparent one, the air's included
+    flags: list[str] = []
+    p = pencil(rig, axis)  # the rig's one rest-pose search: everything below is about this rest pose
+    trials: tuple[Trial, ...] = ()
+    pooled = None
+    if signals is None:
+        found = identify(rig, axis, period, amplitude or 0.0, p.lin.rest)
+        ratio, small = found.amplitude_ratio, period / found.amplitude_ratio
+        small_std = rig.uncertainty.period / ratio
+        std_source = ("the rig file's [uncertainty].period" if small_std > 0.0 else
+                      "none: the rig file states no [uncertainty].period")
+    else:
+        found_trials, pooled = identify_records(rig, axis, list(signals), options, p)
+        trials, ratio = tuple(found_trials), 1.0
+        small, small_std = pooled.period, pooled.period_std
+        std_source = "the records' fits"
+        flags.extend(said_once([said for tr in trials for said in tr.said]))
+        if not pooled.consistent:
+            flags.append(f"the {len(trials)} trials scatter more than their stated sigmas (chi^2 per degree of "
+                         f"freedom {pooled.chi2_per_dof:.3g}): the pooled sigma is scaled by its square root")
+    result = _propagate(rig, axis, small, small_std, samples, flags, p)
+    result = replace(result, period_std_source=std_source,
+                     start_value="nan in the rig file" if was_nan else "the rig file's value (a start only)",
+                     amplitude=(amplitude, amplitude) if amplitude and signals is None else None,
+                     timed_period=period if signals is None and ratio != 1.0 else None,
+                     trials=trials, pooled=pooled)
+    if rig_in_air.air is None:
+        return result
+    # The body's own moment: the air's added moment subtracted. The air is no rigid body: the apparent
+    # tensor may break the triangle inequality; the body's must not.
+    own = without_air(rig_in_air, axis_vector(axis), result.inertia, result.std or 0.0)
+    check = tensor_check(with_moment(rig, axis, own.inertia).inertia)
+    flags = result.flags
+    if check.body:
+        flags = tuple(f for f in flags if not f.startswith(_NO_BODY))
+    return replace(result, air=AirPart(own.inertia, own.std, own.air_share, check), flags=flags)
+
+
+_NO_BODY = "the identified tensor"  # how the flag of a tensor no body has starts
+
+
+def _propagate(rig: Rig, axis: str, period: float, period_std: float, samples, flags: list, p) -> Measurement:
+    """The propagated moment and everything derived from it (per mass, checks, flags); ``p`` is the
+    rig's pencil about ``axis`` (its rest pose and linearisation). The fields :func:`measure` sets after
+    are left at placeholders."""
+    found = invert_period(rig, axis, period, p.lin.rest, p)
+    geometry = [g for g in ("length", "anchor", "attach", "mass", "com") if getattr(rig.uncertainty, g) > 0.0]
+    if samples and (geometry or period_std > 0.0):
+        result = monte_carlo(rig, axis, period, period_std, samples, np.random.default_rng(0))
+    else:
+        result = linear_axes(rig, {axis: period}, period_std, p.lin.rest, {axis: found}, p.lin)[axis]
+    j, m = result.moment, found.rig.mass
+    inp = result.inputs
+    parts = (result.gradient * inp.std) ** 2
+    groups = np.array(inp.groups)
+    rep_var, rig_var = float(parts[groups == "period"].sum()), float(parts[groups != "period"].sum())
+    # J / m: the same inputs; the mass enters as d(J/m)/dm = (dJ/dm)/m - J/m^2
+    per_mass_gradient = result.gradient / m
+    per_mass_gradient[groups == "mass"] -= j / m**2
+    std_pm = float(np.sqrt(np.sum((per_mass_gradient * inp.std) ** 2)))
+    propagated = bool(np.any(inp.std > 0.0))
+    if not geometry:
+        flags.append("the rig file has no [uncertainty] for geometry or mass: nothing of the rig was propagated"
+                     + ("" if period_std > 0.0 else ", nor of the period: no uncertainty is stated"))
+    floor = p.floor
+    if propagated and result.low <= max(floor, 0.0):
+        flags.append(f"the 95 % interval reaches {result.low:.6g} kg m^2, a moment no body has (the tensor is "
+                     f"positive definite only above {max(floor, 0.0):.6g}): this rig cannot determine it")
+    check = tensor_check(with_moment(rig, axis, j).inertia)
+    if not check.body:
+        flags.append(f"{_NO_BODY} (principal moments {', '.join(f'{x:.6g}' for x in check.principal)}) "
+                     f"{'is not positive definite' if not check.positive_definite else 'breaks the triangle inequality'}"
+                     ": no body has it (a wrong period, mode or rig file)")
+    if found.sensitivity < WEAK_SENSITIVITY:
+        flags.append(f"the period hardly depends on this moment (d ln T / d ln I = {found.sensitivity:.3g}): "
+                     "its uncertainty is amplified 1/(2 x that) times")
+    per_mass = j / m
+    k = math.sqrt(per_mass) if per_mass > 0.0 else None
+    return Measurement(
+        rig=rig.name, source=rig.source, axis=axis, mass=rig.mass, com=tuple(rig.com.tolist()), inertia=j,
+        std=result.std if propagated else None,
+        interval95=(result.low, result.high) if propagated else None,
+        std_repeatability=math.sqrt(rep_var) if period_std > 0.0 else None,
+        std_rig=math.sqrt(rig_var) if geometry else None,
+        period=period, period_std=period_std if period_std > 0.0 else None, period_std_source="",
+        sensitivity=found.sensitivity, inertia_per_mass=per_mass, std_per_mass=std_pm if propagated else None,
+        radius_of_gyration=k, radius_of_gyration_std=std_pm / (2.0 * k) if propagated and k else None,
+        method=result.method, budget=result.budget if propagated else None,
+        budget_per_mass=budget(inp, per_mass_gradient) if propagated else None,
+        tensor_check=check, flags=tuple(flags), start_value="")
+
+
+def subtract_tare(whole: Measurement, fixture: Measurement) -> Measurement:
+    """``whole`` (the assembly: fixture and object) with the fixture alone and the object's own moment
+    about the axis through its own COM: (whole - fixture, both about their own COM) by the parallel-axis
+    theorem, the two sigmas combined as independent (conservative: the shared geometry errors correlate
+    and partly cancel). Both measured about the same body axis, in the same body frame."""
+    if whole.mass - fixture.mass <= 0.0:
+        raise RigError(fixture.source, "body.mass", f"{fixture.mass:g} kg: not less than the rig's {whole.mass:g} kg, "
+                                                    "so no object is left")
+    e = axis_vector(whole.axis)
+    com, fix_com = np.array(whole.com), np.array(fixture.com)
+    m_obj, c_obj = object_part(whole.mass, com, fixture.mass, fix_com)
+    about_com = whole.inertia - (fixture.inertia + parallel_axis_moment(fixture.mass, fix_com - com, e))
+    own = about_com - parallel_axis_moment(m_obj, c_obj - com, e)
+    stds = (whole.std, fixture.std)
+    std = math.sqrt(sum(s**2 for s in stds)) if all(s is not None for s in stds) else None
+    part = ObjectMoment(m_obj, tuple(c_obj.tolist()), own, std, own / m_obj,
+                        () if own > 0 else ("the object's moment is not positive",))
+    return replace(whole, tare=fixture, object_part=part)
+
+
+def said_once(said: Sequence[tuple[str, str]]) -> list[str]:
+    """Flags as (who, what) pairs, each ``what`` said once with every ``who`` it applies to, in the order
+    first said: ``"a.csv, b.csv: what"`` (a tensor of 30 records with one warning says it once)."""
+    whom: dict[str, list[str]] = {}
+    for who, what in said:
+        names = whom.setdefault(what, [])
+        if who not in names:
+            names.append(who)
+    return [f"{', '.join(names)}: {what}" for what, names in whom.items()]
+
+
+def trial_dict(tr: Trial, mass: float) -> dict:
+    """The JSON object of one trial: its fit and the moment from it alone (repeatability sigma)."""
+    fit = tr.fit
+    halves = None
+    if tr.halves is not None:
+        h = tr.halves
+        halves = {"first": {"period": h.first[0], "period_std": h.first[1]},
+                  "second": {"period": h.second[0], "period_std": h.second[1]}, "split": h.split, "z": h.z}
+    return {
+        "source": tr.record.source,
+        "period": fit.period,
+        "period_std": fit.period_std,
+        "period_std_statistical": fit.period_std_statistical,
+        "period_std_law": fit.period_std_law,
+        "period_std_white": fit.period_std_white,
+        "inertia": tr.moment,
+        "std": tr.moment_std,
+        "interval95": [tr.moment - Z95 * tr.moment_std, tr.moment + Z95 * tr.moment_std],
+        "inertia_per_mass": tr.moment / mass,
+        "std_per_mass": tr.moment_std / mass,
+        "amplitude": list(fit.amplitude) if fit.amplitude is not None else None,
+        "damping": fit.damping,
+        "law": fit.law.as_dict(),
+        "halves": halves,
+        "rejected": fit.rejected.as_dict(),
+        "residual_rms": fit.rms,
+        "outliers": fit.outliers.tolist(),
+        "second_mode": None if fit.second_mode is None else dict(zip(("period", "amplitude", "decay"), fit.second_mode)),
+        "samples": fit.samples,
+        "binned": fit.binned,
+        "cycles": fit.cycles,
+        "dropped": tr.record.dropped,
+        "unfolded": tr.record.unfolded,
+        "block": fit.block,
+        "jackknife": fit.jackknife,
+        "flags": list(tr.flags),
+    }
