@@ -143,6 +143,7 @@ _LIKELY_FIELD = {
     "validate.engines.mujoco_rig": "initial",
     "bifilar.identification.propagation": "uncertainty",
     "bifilar.identification.identify": "body.inertia",
+    "bifilar.identification.measurement": "body.inertia",
     "validate.commands.identify": "body.inertia",
     "bifilar.identification.records.fit": "signal",  # a record the fit could not use
     "bifilar.identification.records.law": "signal",
