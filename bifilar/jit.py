@@ -3,8 +3,8 @@ kernels that compile only when they loop.
 
 The Kane, TMT and signal kernels are compiled by numba with ``cache=True``. Left to itself numba writes
 its cache into ``__pycache__`` beside the sources (which fails silently in a read-only install, and
-litters a checkout); :func:`use_user_cache` points it at the user's cache folder instead, unless
-``NUMBA_CACHE_DIR`` is already set, and compiles at LLVM's level 2 (:data:`OPT_LEVEL`). The first run
+litters a checkout); :func:`use_user_cache` points it at the user's cache folder instead (one
+subfolder per state of the kernels' sources: :func:`kernels_key`), unless ``NUMBA_CACHE_DIR`` is already set, and compiles at LLVM's level 2 (:data:`OPT_LEVEL`). The first run
 after an install or a change of a kernel compiles for 30-80 s; :func:`announce_compile` says so in one
 line instead of leaving the user in silence, and the suite runs the cases that compile first, one
 worker each (:data:`validate.registry.COMPILES`).
@@ -16,6 +16,7 @@ called often enough to be a loop (:data:`LOOP_CALLS`), and compiles them only th
 
 from __future__ import annotations
 
+import hashlib
 import inspect
 import os
 import sys
@@ -24,9 +25,26 @@ from pathlib import Path
 
 
 def user_cache_dir() -> Path:
-    """``$XDG_CACHE_HOME/bifilar-validate/numba`` (default ``~/.cache/...``)."""
+    """``$XDG_CACHE_HOME/bifilar-validate/numba/<kernels>`` (default ``~/.cache/...``), ``<kernels>``
+    the :func:`kernels_key` of the installed sources."""
     base = os.environ.get("XDG_CACHE_HOME") or str(Path.home() / ".cache")
-    return Path(base) / "bifilar-validate" / "numba"
+    return Path(base) / "bifilar-validate" / "numba" / kernels_key()
+
+
+def kernels_key(root: Path = Path(__file__).parent) -> str:
+    """12 hex digits of a hash of every module under ``root`` (the package) that uses numba: its path
+    and its text.
+
+    numba checks a cached kernel against its own source file only: a kernel whose jitted callee in
+    another module changed, or moved to another module, is loaded stale (a ModuleNotFoundError, or
+    silently the old callee). A folder per state of the kernels' sources makes any such change a
+    fresh cache (everything compiles once, as after an install); hashing ~15 files takes ~1 ms."""
+    digest = hashlib.sha1()
+    for path in sorted(root.rglob("*.py")):
+        text = path.read_bytes()
+        if b"numba" in text:
+            digest.update(str(path.relative_to(root)).encode() + b"\0" + text)
+    return digest.hexdigest()[:12]
 
 
 # LLVM's optimisation level for the kernels. numba's default, 3, compiled the suite's kernels in 153 s

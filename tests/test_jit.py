@@ -130,3 +130,20 @@ def test_one_rigs_modes_compile_nothing(name, tmp_path):
                           env=env, capture_output=True, text=True, timeout=120)
     assert proc.returncode == 0, proc.stderr
     assert not list(tmp_path.rglob("*.nbi")) and "compiling" not in proc.stderr, proc.stderr
+
+
+def test_the_cache_folder_follows_the_kernels_sources(tmp_path):
+    """numba checks a cached kernel against its own file only; the folder key catches a jitted callee
+    changed or moved to another module (a kernel loaded stale), and ignores modules without numba."""
+    from bifilar.jit import kernels_key
+
+    (tmp_path / "kernel.py").write_text("from numba import njit\n@njit(cache=True)\ndef f(x):\n    return g(x)\n")
+    (tmp_path / "callee.py").write_text("from numba import njit\n@njit(cache=True)\ndef g(x):\n    return x\n")
+    first = kernels_key(tmp_path)
+    (tmp_path / "plain.py").write_text("def h():\n    return 1\n")
+    assert kernels_key(tmp_path) == first
+    (tmp_path / "callee.py").write_text("from numba import njit\n@njit(cache=True)\ndef g(x):\n    return 2 * x\n")
+    changed = kernels_key(tmp_path)
+    assert changed != first
+    (tmp_path / "callee.py").rename(tmp_path / "moved.py")
+    assert kernels_key(tmp_path) not in (first, changed)

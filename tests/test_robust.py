@@ -378,7 +378,9 @@ def test_numba_cache_is_outside_the_source_tree_and_a_first_compile_is_announced
     env.pop("NUMBA_CACHE_DIR", None)
     code = "import bifilar.motion.kane_kernel, numba; print(numba.config.CACHE_DIR)"
     proc = subprocess.run([sys.executable, "-c", code], cwd=ROOT, env=env, capture_output=True, text=True, timeout=60)
-    assert proc.stdout.strip() == str(tmp_path / "bifilar-validate" / "numba")
+    from bifilar.jit import kernels_key
+
+    assert proc.stdout.strip() == str(tmp_path / "bifilar-validate" / "numba" / kernels_key())
     from bifilar import jit
     from bifilar.jit import announce_compile
 
