@@ -1,6 +1,7 @@
 """The public surface explains itself (issue 36): what ``bifilar`` and ``bifilar.identification`` export
-resolves, their docstrings' examples run, and every dotted path the project writes for a reader
-(``bifilar.rig.file.load_rig``, ``:mod:`validate.engines.mjcf```) names something that imports.
+resolves, their docstrings' examples run, every dotted path the project writes for a reader
+(``bifilar.rig.file.load_rig``, ``:mod:`validate.engines.mjcf```) names something that imports, and
+every file path from the project's folder (``bifilar/rig/file.py``, ``models/rigs/plate.toml``) exists.
 
 The paths are read from the docstrings and comments of every Python file, every string of the shipped
 packages (``bifilar/``, ``validate/``: messages and generated text such as the MJCF comment), and the
@@ -30,8 +31,14 @@ PATH = re.compile(r"(?<![\w./-])(?:bifilar|validate)(?:\.[A-Za-z_]\w*)+(?![\w/-]
 SHIPPED = ("bifilar", "validate")  # every string of these counts; elsewhere docstrings and comments only
 PYTHON = ("bifilar", "validate", "tests", "benchmarks", "docs", "models")
 TEXT = ("*.md", "docs/*.md", "models/**/*.md", "models/**/*.xml")
-# Written on purpose as a pattern, not a path: name -> why.
-PLACEHOLDERS = {"validate.cases.GROUP": "validate/report/junit.py: a test case's classname, GROUP its module"}
+# A file or folder of the project by its path from the project's folder; one followed by `{`, `*` or `<`
+# is a pattern (``models/rigs/thesis_7_1_lin{1,2,3}.toml``), not a path.
+FILE = re.compile(r"(?<![\w./-])(?:bifilar|validate|tests|docs|models|benchmarks)/[\w./-]*\w(?![\w/{*<])")
+# Written on purpose as a pattern or a place outside the checkout, not a path: name -> why.
+PLACEHOLDERS = {
+    "validate.cases.GROUP": "validate/report/junit.py: a test case's classname, GROUP its module",
+    "validate/_models": "the models/ folder inside an installed wheel (setup.py)",
+}
 
 
 @pytest.mark.parametrize("name", PUBLIC)
@@ -81,17 +88,27 @@ def _python_texts(path, every_string):
 
 
 @functools.cache
-def _written_paths():
-    """{dotted path: [file, ...]} for every path written in the project's docs, docstrings and comments."""
-    found = {}
+def _texts():
+    """(file, [text, ...]) of the project's docs, docstrings and comments (and shipped strings)."""
     files = [(path, _python_texts(path, path.relative_to(ROOT).parts[0] in SHIPPED))
              for folder in PYTHON for path in sorted((ROOT / folder).rglob("*.py"))]
     files += [(path, [path.read_text(encoding="utf-8")]) for pattern in TEXT for path in sorted(ROOT.glob(pattern))]
-    for path, texts in files:
+    return files
+
+
+def _written(pattern):
+    """{what ``pattern`` matches: [file, ...]} over :func:`_texts`."""
+    found = {}
+    for path, texts in _texts():
         for text in texts:
-            for match in PATH.finditer(text):
+            for match in pattern.finditer(text):
                 found.setdefault(match.group(), []).append(str(path.relative_to(ROOT)))
     return found
+
+
+def _written_paths():
+    """{dotted path: [file, ...]} for every path written in the project's docs, docstrings and comments."""
+    return _written(PATH)
 
 
 def _resolves(dotted):
@@ -118,10 +135,20 @@ def test_reader_finds_paths():
     assert _resolves("bifilar.rig.file.load_rig") and not _resolves("bifilar.statics.rest_pose")
     found = _written_paths()
     assert len(found) > 100 and "bifilar.rig.statics.rest_pose" in found
+    text = "(`models/rigs/plate.toml`), docs/air.md. Not models/rigs/lin{1,2}.toml, a/docs/x nor out/<rig>"
+    assert FILE.findall(text) == ["models/rigs/plate.toml", "docs/air.md"]
+    assert "validate/engines/mjcf.py" in _written(FILE)
 
 
 def test_every_written_dotted_path_imports():
     stale = {path: sorted(set(files)) for path, files in sorted(_written_paths().items())
              if path not in PLACEHOLDERS and not _resolves(path)}
     assert not stale, "dotted paths that do not import (path: files):\n" + "\n".join(
+        f"  {path}: {', '.join(files)}" for path, files in stale.items())
+
+
+def test_every_written_file_path_exists():
+    stale = {path: sorted(set(files)) for path, files in sorted(_written(FILE).items())
+             if path not in PLACEHOLDERS and not (ROOT / path).exists()}
+    assert not stale, "file paths that do not exist (path: files):\n" + "\n".join(
         f"  {path}: {', '.join(files)}" for path, files in stale.items())
