@@ -30,7 +30,6 @@ it only points numba's cache at the user's cache folder (:mod:`bifilar.jit`).
 from __future__ import annotations
 
 import importlib
-from typing import TYPE_CHECKING
 
 from bifilar.jit import use_user_cache
 
@@ -57,6 +56,7 @@ _EXPORTS = {
 
 __all__ = sorted(_EXPORTS)
 
+TYPE_CHECKING = False  # typing's own would import typing (2 ms); type checkers know this spelling too
 if TYPE_CHECKING:  # for type checkers and the import graph (tests/test_imports.py); at run time: __getattr__
     from bifilar.identification.hangings import fit_hangings, read_hangings
     from bifilar.identification.identify import Identified, identify, linear_period, simulated_period

@@ -35,7 +35,6 @@ The names load on first use (PEP 562): importing one module of the package does 
 from __future__ import annotations
 
 import importlib
-from typing import TYPE_CHECKING
 
 # name -> the module that defines it, and the name there where it differs
 _EXPORTS = {
@@ -73,6 +72,7 @@ _EXPORTS = {
 
 __all__ = sorted(_EXPORTS)
 
+TYPE_CHECKING = False  # typing's own would import typing (2 ms); type checkers know this spelling too
 if TYPE_CHECKING:  # for type checkers and the import graph (tests/test_imports.py); at run time: __getattr__
     from bifilar.identification.hangings import fit_hangings, read_hangings
     from bifilar.identification.identify import (Identified, amplitude_coefficient, amplitude_ratio, invert_period,
