@@ -4,7 +4,7 @@ For the thesis plate (models/rigs/plate.toml, 10 deg torsion) and the parallel-w
 (models/rigs/parallel.toml, 0.1 rad torsion), each engine simulates the same seconds from the same
 initial state; the table gives simulated seconds per wall-clock second (and per CPU second of this
 process, steadier on a shared machine) and the relative error of the torsion period against the
-exact period of the 1-DOF torsion model (bifilar.lagrange, by quadrature; exact for these symmetric
+exact period of the 1-DOF torsion model (bifilar.motion.lagrange, by quadrature; exact for these symmetric
 rigs, and independent of both engines). Both engines are run once on a short span first, so that compilation is not timed.
 
     python benchmarks/mujoco_vs_kane.py [--duration 10]
@@ -40,7 +40,7 @@ def main() -> None:
     parser.add_argument("--duration", type=float, default=10.0, help="simulated seconds per run")
     args = parser.parse_args()
     print(f"{args.duration:g} s of torsion per run; period error against the exact 1-DOF torsion period "
-          "(energy quadrature, bifilar.lagrange), a formulation independent of both engines")
+          "(energy quadrature, bifilar.motion.lagrange), a formulation independent of both engines")
     print("| rig | engine | sim s / wall s | sim s / CPU s | period rel. err |")
     print("|---|---|---|---|---|")
     for path in RIGS:

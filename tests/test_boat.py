@@ -168,7 +168,7 @@ def test_a_parallelogram_hides_the_pitch_moment():
 
 def test_shipped_xml_matches_the_generated_model():
     """models/solar_boat/{boat,scene}.xml as committed = boat_model.build_spec now; if this fails,
-    regenerate: python -m validate.boat_model models/solar_boat/suspension.toml models/solar_boat."""
+    regenerate: python -m validate.studies.boat_model models/solar_boat/suspension.toml models/solar_boat."""
     fresh = boat_model.build_spec(SUSPENSION, scene=True).compile()
     saved = mujoco.MjModel.from_xml_path(str(BOAT / "scene.xml"))
     body_s, body_f = saved.body("body"), fresh.body("body")

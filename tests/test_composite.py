@@ -26,7 +26,7 @@ MUJOCO = 1e-9  # MuJoCo composes and diagonalizes iteratively in double: ~3e-14 
 
 # Dimensions (m) of one part per shape, and its textbook principal moments per unit mass (m^2)
 # about the centroid along the part axes, and its volume (area for shells) -- written out
-# independently of bifilar.composite.
+# independently of bifilar.bodies.composite.
 R, RI, L = 0.3, 0.2, 1.1
 TEXTBOOK = {
     "box": ({"length": 0.5, "width": 0.3, "height": 0.2},

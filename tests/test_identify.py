@@ -114,7 +114,7 @@ def test_table_7_1_1(name, axis, label, printed, coordinates):
 
 @pytest.mark.parametrize("name", ["parallel", "plate"])
 def test_released_torsion_is_the_exact_one_dof_motion(name):
-    """Released at 0.3 rad about the vertical, the Kane period equals bifilar.lagrange's quadrature
+    """Released at 0.3 rad about the vertical, the Kane period equals bifilar.motion.lagrange's quadrature
     of the exact 1-DOF model: integrator rtol 1e-10, crossing fit ~1e-10, quadrature 1e-13."""
     r = rig(name)
     exact = lagrange.period(lagrange.from_rig(r), 0.3, vertical_ke=True)

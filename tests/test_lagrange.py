@@ -1,4 +1,4 @@
-"""The 1-DOF torsion models of bifilar.lagrange against the thesis's printed formulas, numerical
+"""The 1-DOF torsion models of bifilar.motion.lagrange against the thesis's printed formulas, numerical
 integration of their own equations, their small-amplitude series and the full Kane engine."""
 
 import dataclasses

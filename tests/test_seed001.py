@@ -1,4 +1,4 @@
-"""Seed 001 (bifilar.seed001): the model files, the independently derived equations against MuJoCo,
+"""Seed 001 (bifilar.seeds.seed001): the model files, the independently derived equations against MuJoCo,
 the seed's printed equations against both, the seed's RK4 and the friction's coupling to MuJoCo."""
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""The TMT implementation (bifilar.tmt) on textbook systems with closed forms, its kinematics
+"""The TMT implementation (bifilar.seeds.tmt) on textbook systems with closed forms, its kinematics
 against finite differences, and a skewed spatial chain against MuJoCo (validate.engines.tmt_mujoco)."""
 
 import mujoco

@@ -177,7 +177,7 @@ def tension_colors(tension: np.ndarray, t_max: float) -> np.ndarray:
 
 
 def inertia_box(inertia: np.ndarray, mass: float) -> tuple[np.ndarray, np.ndarray]:
-    """:func:`bifilar.composite.equivalent_box` as half sizes and an xyzw quaternion (rerun's order)."""
+    """:func:`bifilar.bodies.composite.equivalent_box` as half sizes and an xyzw quaternion (rerun's order)."""
     half, axes = equivalent_box(mass, inertia)
     return half, Rotation.from_matrix(axes).as_quat()
 

@@ -261,9 +261,9 @@ def released(rig: Rig, axis, amplitude: float, rest: Rest | None = None) -> Rele
 
     The rest pose is displaced by the associated mode's linear shape, scaled so that the rotation
     vector's component along the axis is ``amplitude``, then moved the shortest way onto the taut-wire
-    poses (:func:`bifilar.statics.taut_shift`). Every speed is zero, so the rotation about the axis
+    poses (:func:`bifilar.rig.statics.taut_shift`). Every speed is zero, so the rotation about the axis
     starts at its turning point: the amplitude is the peak rotation. For a mode that only turns about
-    the axis (the torsion of a symmetric rig) this is exactly the 1-DOF motion of :mod:`bifilar.lagrange`.
+    the axis (the torsion of a symmetric rig) this is exactly the 1-DOF motion of :mod:`bifilar.motion.lagrange`.
     """
     p = pencil(rig, axis, rest)
     k, w2, v = p.associated(p.moment0)
@@ -282,7 +282,7 @@ def simulated_period(rig: Rig, axis, amplitude: float, rest: Rest | None = None)
     """The period (s) the Kane model shows for the mode associated with ``axis`` at ``amplitude``.
 
     From :func:`released`, :data:`_CYCLES` cycles are integrated and the period is the mean interval
-    of the crossings of the rotation angle about the axis (:func:`bifilar.periods.period`).
+    of the crossings of the rotation angle about the axis (:func:`bifilar.identification.periods.period`).
     """
     start = released(rig, axis, amplitude, rest)
     rtol = min(_RTOL, _RTOL_PER_RAD * amplitude)

@@ -11,7 +11,7 @@ standard deviations of :class:`bifilar.rig.Uncertainty`, one per group:
 
 The other entries of the inertia tensor and gravity are taken as exact.
 
-Linear (:func:`linear`): the Jacobian of the exact inversion (:func:`bifilar.identify.invert_period`)
+Linear (:func:`linear`): the Jacobian of the exact inversion (:func:`bifilar.identification.identify.invert_period`)
 by the implicit function theorem. The identified J solves ln T_k(J, x) = ln T_measured, so
 dJ/dx_i = -(d ln T/dx_i) / (d ln T/dJ): d ln T/dJ = s / J with s the inversion's sensitivity
 (Hellmann-Feynman, exact), and d ln T/dx_i, the change of the associated mode's period at fixed J, by

@@ -3,10 +3,10 @@
 :class:`KaneModel` maps a :class:`~bifilar.rig.Rig` to the thesis's parameters (seed 000, ch. 5.1):
 b, b', l, l', r, lambda, the principal inertias and the constant rotation between the thesis's body
 frame n~ and the principal axes b (5.1.6), plus the generalised anchor offset AB. The equations
-themselves live in :mod:`bifilar.kane_kernel` (compiled); this module is the Python face of them.
+themselves live in :mod:`bifilar.motion.kane_kernel` (compiled); this module is the Python face of them.
 
 Charts: angles are ``theta`` in the thesis's POLAR chart unless a ``chart`` argument says TILT (the
-remedy for a vertical wire 1; see :mod:`bifilar.kane_kernel`).
+remedy for a vertical wire 1; see :mod:`bifilar.motion.kane_kernel`).
 """
 
 from __future__ import annotations

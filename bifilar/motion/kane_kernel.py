@@ -14,7 +14,7 @@ Chart remedy: the polar chart of BC is singular at theta2 = 0 (a vertical wire, 
 parallel-wire rig at rest). The TILT chart writes the same unit vector as
 u = (sin q3, -sin q2 cos q3, -cos q2 cos q3), singular only for a horizontal wire along n1. Every
 term below is built from u and its first and second partial derivatives, so the Kane equations are
-the same code in either chart; :mod:`bifilar.simulate` switches charts before either degenerates.
+the same code in either chart; :mod:`bifilar.motion.simulate` switches charts before either degenerates.
 
 Instead of transcribing the appendix's entries, the kernel assembles the thesis's matrices from
 their definitions: V = C + W (5.1.17) with W's columns G e_i x r, the velocity-product term

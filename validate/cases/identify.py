@@ -1,7 +1,7 @@
 """Cases for moments of inertia identified from periods and from wire tensions (seed 000, ch. 7.1-7.2).
 
 "Measured" periods come from the Kane model released along the mode at 1e-6 rad
-(:func:`bifilar.identify.simulated_period`): there the amplitude shifts the period by ~1e-12 and the
+(:func:`bifilar.identification.identify.simulated_period`): there the amplitude shifts the period by ~1e-12 and the
 integrator, whose tolerance follows the amplitude, by ~1e-9; the crossing-time fit of a mode that
 turns only partly about the axis sees the other modes, excited at O(A^2), as jitter of relative size
 ~1e-8. A moment then inherits the period's error divided by d ln T / d ln I (>= 0.06 in these rigs),
@@ -39,7 +39,7 @@ TABLE_7_1_1 = (
 
 def thesis_rest(name: str) -> Rest | None:
     """The rest pose the thesis linearises about: the level plate. For Linearization 1 (lambda = 0)
-    every tilt about CD is a rest pose, and :func:`bifilar.statics.rest_pose` returns one tilted by
+    every tilt about CD is a rest pose, and :func:`bifilar.rig.statics.rest_pose` returns one tilted by
     ~0.18 rad; the level one is the same COM and tensions with the body frame unrotated."""
     if name != "thesis_7_1_lin1":
         return None
@@ -117,7 +117,7 @@ def exact_inversion(ctx: CaseContext):
 @case("identify-amplitude", source="000 ch. 5.2, 7.1", engines=("kane", "analytic"))
 def amplitude(ctx: CaseContext):
     """A period timed at 0.3 rad: the Kane model's T(A) against the exact 1-DOF quadrature of
-    bifilar.lagrange (independent), and the amplitude-corrected inversion against the truth."""
+    bifilar.motion.lagrange (independent), and the amplitude-corrected inversion against the truth."""
     r = rig("parallel")
     a = 0.3
     measured = ident.simulated_period(r, "z", a)

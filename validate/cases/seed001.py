@@ -1,4 +1,4 @@
-"""Seed 001: the double-arm pendulum with counterweight and friction (:mod:`bifilar.seed001`),
+"""Seed 001: the double-arm pendulum with counterweight and friction (:mod:`bifilar.seeds.seed001`),
 Lagrange's equations as printed in the seed, against MuJoCo.
 
 Engines, all from ``models/seed001/params.toml``: ``seed001-lagrange`` integrates the printed f and

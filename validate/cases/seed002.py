@@ -1,4 +1,4 @@
-"""Seed 002: the TMT three-body pendulum (:mod:`bifilar.seed002`) against MuJoCo.
+"""Seed 002: the TMT three-body pendulum (:mod:`bifilar.seeds.seed002`) against MuJoCo.
 
 Both engines read ``models/seed002/params.toml``. The TMT engine integrates ``M* q'' = F* - N* q'``
 with DOP853; MuJoCo steps the same chain (:mod:`validate.engines.tmt_mujoco`) with RK4. q = (theta, phi),

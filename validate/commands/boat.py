@@ -1,4 +1,4 @@
-"""``python -m validate boat``: the Solar Boat study of the thesis's ch. 8 (:mod:`validate.boat_study`).
+"""``python -m validate boat``: the Solar Boat study of the thesis's ch. 8 (:mod:`validate.studies.boat_study`).
 
 Prints, per configuration, each moment identified from its timed motion against the thesis's
 estimate and the truth with its predicted standard deviation, the wire tensions and deck loads, and
@@ -56,7 +56,7 @@ def run(args) -> int:
 
 
 def report(data: dict) -> str:
-    """The study's summary (:func:`validate.boat_study.summary`) as text tables."""
+    """The study's summary (:func:`validate.studies.boat_study.summary`) as text tables."""
     hall = data["hall"]
     lines = [
         f"Solar Boat: {data['mass']:.4g} kg, COM {data['com_below_deck']:.4f} m below the deck, pilot "

@@ -3,10 +3,10 @@
 The model is one free body hung from two cables; every vector is in the world frame (z up, gravity
 along -z) unless it says body frame. The body frame is the rig file's own body frame, so the sites
 ``attach1``/``attach2`` sit at the rig's ``attach`` points and the inertial at ``rig.com``. The model
-is built at the rest pose (``qpos0`` and keyframe ``rest`` are :func:`bifilar.statics.rest_pose`), so
+is built at the rest pose (``qpos0`` and keyframe ``rest`` are :func:`bifilar.rig.statics.rest_pose`), so
 that MuJoCo's reference quantities computed at ``qpos0`` (tendon lengths, the constraint-space inertia
 used by the soft-constraint regularizer) are those of the pendulum at rest; keyframe ``initial`` is
-:func:`bifilar.statics.initial_state`.
+:func:`bifilar.rig.statics.initial_state`.
 
 Two cable models (``CABLES``):
 
@@ -337,7 +337,7 @@ def _add_air(spec: mujoco.MjSpec, body: mujoco.MjsBody, rig: Rig) -> None:
 
 
 def _inertia_box(rig: Rig) -> tuple[np.ndarray, np.ndarray]:
-    """:func:`bifilar.composite.equivalent_box` as half sizes, no edge thinner than ``_MIN_BOX`` of the
+    """:func:`bifilar.bodies.composite.equivalent_box` as half sizes, no edge thinner than ``_MIN_BOX`` of the
     longest (a flat body stays visible), and a wxyz quaternion (MuJoCo's order)."""
     half, axes = equivalent_box(rig.mass, rig.inertia)
     return np.maximum(half, _MIN_BOX * half.max()), Rotation.from_matrix(axes).as_quat(scalar_first=True)
@@ -357,7 +357,7 @@ def _header(rig: Rig, cables: str, numerics: Numerics) -> str:
           + ("." if w.axial_stiffness is None else f" unstretched, EA {w.axial_stiffness!r} N: tendon stiffness EA / L, "
              "springlength [0, L] (pulls only when longer than L).")
           for i, w in enumerate(rig.wires, start=1)),
-        "qpos0 and keyframe 'rest': bifilar.statics.rest_pose; keyframe 'initial': the rig's [initial] state.",
+        "qpos0 and keyframe 'rest': bifilar.rig.statics.rest_pose; keyframe 'initial': the rig's [initial] state.",
         (f"Numerics (models/README.md): timestep {numerics.timestep:g} s, {numerics.integrator}; cable solref "
          f"{timeconst:g} s{' (2 timesteps)' if numerics.timeconst is None else ''} {dampratio:g},"),
         f"  solimp {' '.join(f'{x:g}' for x in numerics.solimp)} (constant impedance);",

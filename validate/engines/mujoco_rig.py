@@ -2,7 +2,7 @@
 
 ``ENGINES`` holds two engines, ``mujoco`` (tendon cables: one-sided, may go slack) and ``mujoco-eq``
 (equality cables: two-sided), both with the chosen :data:`~validate.engines.mjcf.CHOSEN` numerics.
-Both start from :func:`bifilar.statics.initial_state` unless given another state, like every engine.
+Both start from :func:`bifilar.rig.statics.initial_state` unless given another state, like every engine.
 
 Sampling: between samples ``mj_step(nstep=dt_out / timestep)`` advances in C. After ``mj_step`` the
 derived quantities in ``mjData`` (``efc_force``, ``ten_length``, ``qacc``) are those computed at the

@@ -1,5 +1,5 @@
 """The MuJoCo model of seed 001's pendulum, built with MjSpec from ``models/seed001/seed001.xml`` and a
-:class:`~bifilar.seed001.params.Params`.
+:class:`~bifilar.seeds.seed001.params.Params`.
 
 The XML gives the structure (bodies, hinges, drawing); every physical number is set here from the
 parameters, so one XML serves every variant (e.g. the special case r_m2 = 0). World frame: x is the

@@ -1,4 +1,4 @@
-"""MuJoCo model of seed 002's three-body pendulum: the TMT chain of :mod:`bifilar.seed002` as an
+"""MuJoCo model of seed 002's three-body pendulum: the TMT chain of :mod:`bifilar.seeds.seed002` as an
 MjSpec (one hinge per coordinate), with visual geoms and the release keyframe."""
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""The MuJoCo counterpart of a TMT chain (:mod:`bifilar.tmt`): the model, and the quantities to compare.
+"""The MuJoCo counterpart of a TMT chain (:mod:`bifilar.seeds.tmt`): the model, and the quantities to compare.
 
 :func:`chain_spec` turns a chain into an :class:`mujoco.MjSpec` with one MuJoCo body per TMT body,
 its frame at the body's COM with the TMT body axes (so that ``xpos``/``xmat`` are the seed's ``x^i``
@@ -16,7 +16,7 @@ whole kinematic tree ``subtree_com[body_rootid[b]]``, and it equals the subtree'
 ``I (a - g) + v x* I v``. So ``cfrc_int[b] - sum over children c of cfrc_int[c]`` is body b's own
 ``m (a - g)`` and its rate of angular momentum, referred to that point; :func:`body_loads` moves the
 torque to b's COM, adds gravity back and rotates the moment into body axes, which gives the seed's
-per-body resultants of :meth:`bifilar.tmt.Chain.body_loads`.
+per-body resultants of :meth:`bifilar.seeds.tmt.Chain.body_loads`.
 """
 
 from __future__ import annotations

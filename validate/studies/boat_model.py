@@ -11,7 +11,7 @@ viewer. Keyframe ``initial`` is the thesis's torsion release, pi/12 about the ve
 The scene puts the floor at the hall's floor, ``hook_height`` under the highest hook.
 
 Regenerate after changing the parts or the hall:
-``python -m validate.boat_model models/solar_boat/suspension.toml models/solar_boat``.
+``python -m validate.studies.boat_model models/solar_boat/suspension.toml models/solar_boat``.
 """
 
 from __future__ import annotations
@@ -46,7 +46,7 @@ _RGBA = {
 
 
 def part_geom(part) -> dict:
-    """MjSpec geom attributes drawing one part (bifilar.composite.Part): type, size, pose, colour."""
+    """MjSpec geom attributes drawing one part (bifilar.bodies.composite.Part): type, size, pose, colour."""
     d = part.dims
     if "width" in d:
         kind, size = mujoco.mjtGeom.mjGEOM_BOX, [0.5 * d["length"], 0.5 * d["width"], 0.5 * d["height"]]
@@ -93,7 +93,7 @@ def write_model_files(s: Suspension, directory: str | Path) -> tuple[Path, Path]
 
 
 def main(argv: list[str] | None = None) -> int:
-    """``python -m validate.boat_model SUSPENSION.toml DIR``: write DIR/boat.xml and DIR/scene.xml."""
+    """``python -m validate.studies.boat_model SUSPENSION.toml DIR``: write DIR/boat.xml and DIR/scene.xml."""
     return mjcf.xml_main(argv, main.__doc__, "suspension file (TOML), e.g. models/solar_boat/suspension.toml",
                          lambda path, out: write_model_files(load_suspension(path), out))
 

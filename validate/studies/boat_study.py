@@ -1,13 +1,13 @@
 """The Solar Boat study of the thesis's ch. 8.2-8.4, redone with the exact method, for any suspension
-file (:mod:`bifilar.boat`).
+file (:mod:`bifilar.bodies.boat`).
 
 For every configuration:
 
 * Moments (ch. 8.3). The thesis's three motions, each released at pi/80 along the mode that turns
-  about the axis (:func:`bifilar.identify.released`): torsion (its theta4) for yaw I1, the swing in
+  about the axis (:func:`bifilar.identification.identify.released`): torsion (its theta4) for yaw I1, the swing in
   the wires' plane (theta2: the wire turns by pi/80) for pitch I2, and the roll about CD (theta1) for
   roll I3. The Kane model's period of that release is the "measured" period; the exact inversion
-  (:func:`bifilar.identify.identify`, with the amplitude correction) turns it into the moment,
+  (:func:`bifilar.identification.identify.identify`, with the amplitude correction) turns it into the moment,
   starting from the thesis's own estimate (Table 8.3.4). The truth is the parts' moment about the
   body axis. The rest pose, the modes and the predicted standard deviation of each moment (the
   suspension file's ``[uncertainty]`` propagated through the exact inversion) are the sweep's: each
