@@ -1,8 +1,10 @@
 """Identification: moments of inertia from measured periods, signals or tensions, with their
 propagated uncertainty.
 
-One function per measurement (``docs/identification.md``), here by name: a period inverted into the
-moment about a body axis (:func:`invert_period`; with the amplitude corrected for:
+One function per measurement (``docs/identification.md``), here by name: a moment measured from a
+period or records with its propagated sigma, as ``validate identify`` reports it (:func:`measure`,
+returning a frozen :class:`Measurement`; a fixture subtracted: :func:`subtract_tare`), a period inverted
+into the moment about a body axis (:func:`invert_period`; with the amplitude corrected for:
 :func:`bifilar.identification.identify.identify`, also :func:`bifilar.identify`), the rig's own
 periods (:func:`linear_period`, :func:`simulated_period`, :func:`amplitude_ratio`), a period from
 crossing times (:func:`period`), records read, fitted and pooled (:func:`read_record`,
@@ -29,6 +31,14 @@ damped), its period fitted and inverted into the moment about z (run from the pr
 >>> print(f"{found.moment:.4f} kg m^2, d ln T / d ln J = {found.sensitivity:.2f}")
 0.1346 kg m^2, d ln T / d ln J = 0.50
 
+The same period through :func:`measure`: the moment with the sigma propagated from the rig file's
+``[uncertainty]`` (the stopwatch's period sigma, the tape measure's lengths, the scale's mass):
+
+>>> from bifilar.identification import measure
+>>> result = measure(rig, "z", period=fit.period)
+>>> print(f"{result.inertia:.4f} +- {result.std:.4f} kg m^2")
+0.1346 +- 0.0005 kg m^2
+
 The names load on first use (PEP 562): importing one module of the package does not import them all.
 """
 
@@ -44,6 +54,9 @@ _EXPORTS = {
     "simulated_period": "bifilar.identification.identify",
     "amplitude_ratio": "bifilar.identification.identify",
     "amplitude_coefficient": "bifilar.identification.identify",
+    "Measurement": "bifilar.identification.measurement",
+    "measure": "bifilar.identification.measurement",
+    "subtract_tare": "bifilar.identification.measurement",
     "Period": "bifilar.identification.periods",
     "period": "bifilar.identification.periods",
     "Record": "bifilar.identification.records.read",
@@ -77,6 +90,7 @@ if TYPE_CHECKING:  # for type checkers and the import graph (tests/test_imports.
     from bifilar.identification.hangings import fit_hangings, read_hangings
     from bifilar.identification.identify import (Identified, amplitude_coefficient, amplitude_ratio, invert_period,
                                                  linear_period, simulated_period)
+    from bifilar.identification.measurement import Measurement, measure, subtract_tare
     from bifilar.identification.periods import Period, period
     from bifilar.identification.plan import candidates
     from bifilar.identification.propagation import linear as propagate_linear
