@@ -40,9 +40,11 @@ def damping_shift(damping: dict, amplitude: np.ndarray) -> np.ndarray:
     friction (zeta_eff the decrement per radian), ~1e-5 of the period for a hardly damped video record
     released at 1 rad, as large as its statistical sigma. So it is measured: one and a half cycles of
     theta'' + theta = -2 zeta theta' - c |theta'| theta' - m tanh(theta' / eps) from each amplitude (a
-    grid, RK4 at 256 steps per cycle: the shift to ~1e-3 of itself, for at most three cycles: a swing
-    that dry friction stops has no second crossing), the period from descending crossing to descending
-    crossing, and the amplitude half way (the trough) it belongs to."""
+    grid, RK4 at h = 2 pi / 256 for at most three cycles: a swing that dry friction stops has no second
+    crossing), the period from descending crossing to descending crossing, and the amplitude half way
+    (the trough) it belongs to. The shift is right to RK4's phase error h^4 / 120 = 3e-9 of the period
+    and ~1e-3 of itself; with dry friction, whose switch at the turning points a fixed step straddles,
+    to a few % of itself (tests/test_record_fit.py, against DOP853 at rtol 1e-12)."""
     zeta, quad, dry = damping["linear"], damping["quadratic"], damping["dry"]
     amplitude = np.asarray(amplitude, dtype=float)
     if zeta == quad == dry == 0.0 or not len(amplitude):
