@@ -1,5 +1,5 @@
-"""The record fit's statistical sigma checked by its jackknife (bifilar.identification.records.fit,
-_Model.jackknife): tracking noise correlated over a fraction of a cycle moves a cycle's phase,
+"""The record fit's statistical sigma checked by its jackknife (bifilar.identification.records.phase_law,
+Model.jackknife): tracking noise correlated over a fraction of a cycle moves a cycle's phase,
 amplitude and waveform together, which the fit's covariance does not model. On such records the
 jackknife over 20 groups of cycles is larger than the covariance at 95 % and sets the sigma; on short
 clean records it is not, and the covariance's efficiency is kept. Coverage over many records with
@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 import bifilar.identification.records.fit as F
+import bifilar.identification.records.phase_law as P
 from bifilar.identification.records import synthetic as Y
 from bifilar.identification.records.law import AmplitudeLaw
 from bifilar.motion import lagrange as L
@@ -25,7 +26,7 @@ def test_the_jackknife_widens_a_covariance_that_coloured_noise_leaves_short(monk
                       zeta=1.2e-3, excess=0.25, shape=0.1)
     rec = Y.record(ROD, np.random.default_rng(0), traits)
     fit = F.fit_oscillation(rec.t, rec.y, "angle", LAW)
-    monkeypatch.setattr(F, "JACKKNIFE_GROUPS", 0)
+    monkeypatch.setattr(P, "JACKKNIFE_GROUPS", 0)
     alone = F.fit_oscillation(rec.t, rec.y, "angle", LAW)
     assert fit.jackknife == 20 and alone.jackknife == 0
     assert fit.period == alone.period  # the jackknife changes the sigma, never T0
@@ -52,7 +53,7 @@ def test_a_law_no_rig_has_is_said_and_its_sigma_holds_both_periods():
     rec = Y.record(ROD, np.random.default_rng(1), Y.Traits(amplitude=0.8, cycles=40.0, excess=3.0, white=0.003,
                                                             zeta=1e-3))
     fit = F.fit_oscillation(rec.t, rec.y, "angle", LAW)
-    assert fit.law.conflict is not None and fit.law.conflict > F.LAW_CONFLICT  # measured 9.4
+    assert fit.law.conflict is not None and fit.law.conflict > P.LAW_CONFLICT  # measured 9.4
     assert fit.period_std > 0.01 * fit.period  # measured 11 %: the ideal law's T0 is that far
     assert abs(fit.period - rec.period) < 1.0 * fit.period_std  # the learned T0 is the near one (0.6 %)
 

@@ -1,7 +1,9 @@
 """Measured records of a swinging rig, from file to moment of inertia.
 
 The loop is :func:`.pipeline.identify_records`: read (:mod:`.read`) -> fit cycle by cycle
-(:mod:`.fit`, what is left out: :mod:`.clean`) -> the amplitude law (:mod:`.law`) -> refit -> invert
+(:mod:`.fit`, its steps each a module: the cycles :mod:`.cycles`, what is left out :mod:`.clean`, the
+phases' law :mod:`.phase_law`, the damping :mod:`.damping`, the spread :mod:`.spread`, a second mode
+:mod:`.second_mode`, the whole record :mod:`.whole`) -> the amplitude law (:mod:`.law`) -> refit -> invert
 -> pool. :mod:`.synthetic` makes records with real traits and a known truth.
 """
 

@@ -33,6 +33,7 @@ from bifilar.rig import RigError
 KINDS = ("angle", "rate", "proportional")
 TIME_COLUMNS = ("t", "time", "timestamp")
 MIN_SAMPLES = 20  # the fit has up to a dozen parameters and needs residual degrees of freedom
+MIN_CYCLES = 3  # cycles measured on their own: fewer, and no phase slope can be told from the law
 _MAX_BYTES = 200 * 2**20  # 200 MB: a day of 240 fps video; anything larger is not a record
 _FOLD = math.pi  # a line tracker cannot tell theta from theta + pi
 _TO_SECONDS = {"s": 1.0, "ms": 1e-3}

@@ -1,0 +1,287 @@
+"""A record measured cycle by cycle: windows one local period long, each fitted on its own.
+
+Step 1 of the record fit (:mod:`.fit`). In each window, least squares gives the offset and the odd
+harmonics of the phase under the decay's envelope, with the window's frequency refined
+(:func:`_window_fit`): the fundamental's phase at the centre with its variance, and its amplitude.
+Over a whole cycle these are orthogonal, so the offset, its drift and the waveform's harmonics take
+nothing from the phase, and the fit never models the damping, the drift or the tracker. A pass
+(:func:`measure`) fits every window with the local frequency and decay the last pass's law gives,
+leaves out glitches and bad cycles (:mod:`.clean`) and refits; the slow offset under the swing
+(:func:`baseline_of`) is subtracted before the next. The first pass's single frequency is the record's
+own (:func:`rough_frequency`).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.signal import lombscargle
+
+from .bounds import Deadline, window_centres
+from .clean import OUTLIER_Z, glitches, mark
+from .read import MIN_CYCLES, MIN_SAMPLES
+
+_WINDOW_SAMPLES = 12  # a window's terms (up to 9 with many samples a cycle) need residual degrees of freedom
+_WINDOW_GAP = 0.35  # largest gap inside a window, in windows: more and its terms are not orthogonal
+_FREQUENCY_STEPS = 3  # Gauss-Newton steps on a window's frequency
+_FREQUENCY_RANGE = 0.05  # the largest relative step (a window's swing is within 5 % of the model's)
+# At most this many samples in a periodogram (starting values only). The record's own frequency is taken
+# from as many bin means of a longer record, not a stride: a stride kept the full rate's noise, whose
+# derivative (1e-3 rad at 2500 Hz: 2.5 rad/s) drowned a 0.3 rad swing's (0.9 rad/s), and a 400-cycle
+# record came out at 2.4 rad/s for 3.13 (its second half at 6.8).
+PERIODOGRAM_SAMPLES = 1024
+_BASELINE_CYCLES = 3.0  # the baseline: the offsets smoothed over this many cycles either side
+
+
+@dataclass
+class Samples:
+    """The samples being fitted and what is known of them."""
+
+    tau: np.ndarray  # s from the first sample
+    y: np.ndarray
+    kind: str
+    usable: np.ndarray  # not stuck, not a glitch
+    step: float  # median sample spacing, s
+    omega: float = math.nan  # the record's own frequency, rad/s (:func:`rough_frequency`)
+    binned: int = 1  # samples a bin of a dense record (:func:`.bounds.binned`)
+    deadline: Deadline = field(default_factory=Deadline)
+
+
+@dataclass
+class Cycles:
+    """Local fits of one pass: per window, its centre (s), local frequency (rad/s) and decay rate, phase of the
+    fundamental at the centre (rad, wrapped), its variance, the fundamental's amplitude and the
+    offset (signal units), the residual RMS, the sample indices and the terms (for the model)."""
+
+    centre: np.ndarray
+    omega: np.ndarray
+    decay: np.ndarray  # d ln(amplitude) / dt at the centre, 1/s
+    phase: np.ndarray
+    phase_var: np.ndarray
+    fundamental: np.ndarray
+    offset: np.ndarray
+    rms: np.ndarray
+    index: list
+    terms: list
+    good: np.ndarray = field(default=None)
+    reason: list = field(default=None)
+    chirp: np.ndarray = field(default=None)  # d omega / dt at the centre, rad/s^2
+    fitted_omega: np.ndarray = field(default=None)  # the window's own frequency (:func:`_window_fit`)
+
+
+def rough_frequency(rec: Samples) -> float:
+    """Angular frequency (rad/s) of the strongest oscillation: the Lomb-Scargle peak of the signal's
+    derivative (of the signal itself for a rate), so that an offset, a slow drift or a tracker's
+    lock-on jumps do not make the peak; differences across gaps and beyond 6 robust sigmas are left out. A
+    record longer than :data:`PERIODOGRAM_SAMPLES` is taken in as many bin means."""
+    keep = rec.usable
+    tau, y = rec.tau[keep], rec.y[keep]
+    group = -(-len(tau) // PERIODOGRAM_SAMPLES)
+    if group > 1:  # bin means of a long record (their noise falls as the bins grow)
+        m = len(tau) // group * group
+        tau, y = tau[:m].reshape(-1, group).mean(axis=1), y[:m].reshape(-1, group).mean(axis=1)
+    step = rec.step * group
+    if rec.kind == "rate":
+        x, v = tau, y - np.median(y)
+    else:
+        dt = np.diff(tau)
+        ok = dt <= 1.5 * step
+        x, v = 0.5 * (tau[1:] + tau[:-1])[ok], (np.diff(y) / dt)[ok]
+    if len(x) < MIN_SAMPLES:
+        raise ValueError(f"{len(x)} usable samples; at least {MIN_SAMPLES} are needed")
+    # a step (the tracker locking on) is a spike of the derivative, clipped here; the derivative weighs a
+    # mode by its frequency squared, which a second mode beating in (a few percent of the swing, at most a
+    # few times its frequency) does not make up for, while the tracker's red noise and drift fall away
+    dev = np.abs(v - np.median(v))
+    mad = 1.4826 * float(np.median(dev)) or float(dev.max()) or 1.0
+    x, v = x[dev <= OUTLIER_Z * mad], v[dev <= OUTLIER_Z * mad]
+    span = rec.tau[-1]
+    resolution = 2.0 * math.pi / span
+    nyquist = math.pi * (len(x) - 1) / (x[-1] - x[0])
+    grid = np.arange(MIN_CYCLES * resolution, nyquist, 0.5 * resolution)
+    if len(grid) < 3:
+        raise ValueError(f"the record is too short or too sparse to hold {MIN_CYCLES} cycles")
+    power = lombscargle(x, v, grid, floating_mean=True)
+    k = int(np.argmax(power))
+    if k == 0 or k == len(grid) - 1:
+        raise ValueError(f"no oscillation peak inside {grid[0]:.4g}..{grid[-1]:.4g} rad/s: fewer than "
+                         f"{MIN_CYCLES} cycles, or undersampled")
+    fine = grid[k] + np.linspace(-0.5, 0.5, 21) * resolution
+    fpower = lombscargle(x, v, fine, floating_mean=True)
+    return float(fine[int(np.argmax(fpower))])
+
+
+def measure(rec: Samples, baseline: np.ndarray, local, second) -> Cycles:
+    """One pass over the record: windows one local period long, centred a local period apart from the
+    first sample (:func:`.bounds.window_centres`: never more than the record's band allows), fitted
+    (:func:`_cycles`) with the local frequency and decay rate ``local(times)``
+    gives, glitches rejected and refitted, bad cycles marked."""
+    rec.deadline.check()
+    y = rec.y - baseline - (second.signal(rec.tau) if second is not None else 0.0)
+    centres = window_centres(float(rec.tau[-1]), rec.omega, local)
+    omegas, decays = local(centres)
+    step = 0.25 * float(np.min(2.0 * math.pi / omegas))
+    chirps = (local(centres + step)[0] - local(centres - step)[0]) / (2.0 * step)
+    usable = rec.usable.copy()
+    for _ in range(4):
+        cyc = _cycles(rec.tau, y, usable, centres, omegas, decays, chirps, rec.kind == "rate")
+        glitch = glitches(_residuals(rec.tau, y, cyc), len(y))
+        if not glitch.any():
+            break
+        usable &= ~glitch
+    cyc.usable = usable
+    mark(cyc)
+    return cyc
+
+
+
+def _residuals(tau: np.ndarray, y: np.ndarray, cyc: Cycles) -> list:
+    """Each fitted window's (sample indices, residual of its least squares): what :func:`.clean.glitches`
+    looks for spikes in."""
+    return [(idx, y[idx] - _basis(tau[idx] - c, w, lam, len(coef) - 2, chirp) @ coef)
+            for c, w, lam, chirp, idx, coef in zip(cyc.centre, cyc.fitted_omega, cyc.decay, cyc.chirp, cyc.index,
+                                                   cyc.terms)
+            if idx is not None and len(idx) >= 3]
+
+
+def _cycles(tau, y, usable, centres, omegas, decays, chirps, rate: bool) -> Cycles:
+    """Least squares in every window (:mod:`.fit`, step 1); windows without the samples to
+    determine their terms are returned marked, with nan phase."""
+    n = len(centres)
+    out = Cycles(centres, omegas, decays, np.full(n, np.nan), np.full(n, np.nan), np.full(n, np.nan),
+                  np.full(n, np.nan), np.full(n, np.nan), [None] * n, [None] * n)
+    out.reason = [None] * n
+    out.chirp = chirps
+    out.fitted_omega = np.array(omegas, dtype=float)
+    out.peak_ratio = np.full(n, np.nan)
+    out.amplitude_var = np.full(n, np.nan)
+    for k, (c, w, lam, chirp) in enumerate(zip(centres, omegas, decays, chirps)):
+        half = math.pi / w
+        lo, hi = np.searchsorted(tau, [c - half, c + half])
+        idx = np.arange(lo, hi)[usable[lo:hi]]
+        if len(idx) < _WINDOW_SAMPLES:
+            out.reason[k] = "too few samples"
+            continue
+        u = tau[idx] - c
+        edges = np.concatenate([[-half], u, [half]])
+        if np.max(np.diff(edges)) > _WINDOW_GAP * 2.0 * half:
+            out.reason[k] = "frames lost"
+            continue
+        wf, x, coef = _window_fit(u, y[idx], w, lam, highest_harmonic(len(idx)), chirp)
+        out.fitted_omega[k] = wf
+        r = y[idx] - x @ coef
+        dof = len(idx) - x.shape[1] - 1
+        var = float(r @ r) / dof
+        cov = var * np.linalg.inv(x.T @ x)
+        a1, b1 = coef[1], coef[2]
+        amp2 = a1 * a1 + b1 * b1
+        g = np.array([b1, -a1]) / max(amp2, 1e-300)  # d phase / d (a1, b1), phase = atan2(-b1, a1)
+        phase = math.atan2(-b1, a1)
+        out.phase[k] = phase
+        # the waveform's peak over its fundamental: a symmetric oscillator's odd harmonics all peak at
+        # the turning point, a_n = alpha_n cos(n phi) - beta_n sin(n phi) (for a rate, its n-th harmonic is
+        # n omega a_n)
+        peak = 0.0
+        for j, n in enumerate(range(1, (len(coef) - 1), 2)):
+            an = coef[1 + 2 * j] * math.cos(n * phase) - coef[2 + 2 * j] * math.sin(n * phase)
+            peak += an / (n if rate else 1.0)
+        out.peak_ratio[k] = peak / math.sqrt(amp2)
+        out.phase_var[k] = float(g @ cov[1:3, 1:3] @ g)
+        out.fundamental[k] = math.sqrt(amp2)
+        radial = np.array([a1, b1]) / math.sqrt(max(amp2, 1e-300))
+        out.amplitude_var[k] = float(radial @ cov[1:3, 1:3] @ radial)
+        out.offset[k] = coef[0]
+        out.rms[k] = math.sqrt(var)
+        out.index[k] = idx
+        out.terms[k] = coef
+    return out
+
+
+def _window_fit(u: np.ndarray, y: np.ndarray, w: float, lam: float, harmonics: int, chirp: float):
+    """(frequency, design, terms) of one window's least squares with its frequency refined from ``w``
+    by Gauss-Newton (:data:`_FREQUENCY_STEPS` steps on the terms' joint linearisation, each kept only
+    where it lowers the residual, within :data:`_FREQUENCY_RANGE` of ``w``): a window whose swing is
+    far from the model's (the first pass's single frequency, a cycle the model held from its
+    neighbours) would otherwise leave a residual that grows as its phase runs off the window's, and be
+    taken for a tracker that has not locked on. The phase at the centre, u = 0, does not depend on the
+    frequency to first order (a symmetric window), so refining it moves the residual, not the phase."""
+    def solve(wf):
+        x = _basis(u, wf, lam, harmonics, chirp)
+        coef, *_ = np.linalg.lstsq(x, y, rcond=None)
+        r = y - x @ coef
+        return x, coef, float(r @ r)
+
+    x, coef, best = solve(w)
+    wf = w
+    for _ in range(_FREQUENCY_STEPS):
+        phase = wf * u + 0.5 * chirp * u * u
+        slope = np.zeros(len(u))
+        for j, n in enumerate(range(1, harmonics + 1, 2)):  # d (x @ coef) / d w
+            a, b = coef[1 + 2 * j], coef[2 + 2 * j]
+            slope += n * (b * np.cos(n * phase) - a * np.sin(n * phase))
+        slope *= u * np.exp(lam * u)
+        step = np.linalg.lstsq(np.column_stack([x, slope]), y - x @ coef, rcond=None)[0][-1]
+        w_new = float(np.clip(wf + step, w * (1.0 - _FREQUENCY_RANGE), w * (1.0 + _FREQUENCY_RANGE)))
+        trial = solve(w_new)
+        if trial[2] >= best:
+            break
+        wf = w_new
+        x, coef, best = trial
+    return wf, x, coef
+
+
+def _basis(u: np.ndarray, w: float, lam: float, harmonics: int, chirp: float = 0.0) -> np.ndarray:
+    """Offset, then the odd harmonics 1, 3, .. up to ``harmonics`` (cos, sin pairs) of the phase
+    w u + chirp u^2 / 2 (the frequency drifting at ``chirp`` rad/s^2 as the amplitude law slows the
+    swing down), under the envelope e^(lam u) of the amplitude's own decay: a decaying swing fitted
+    with a constant one would shift the centre's phase by ~lam / w, and that shift changes as the decay
+    slows; a chirp left out leaves a residual ~chirp T^2 / 8 times the amplitude, far above a good
+    tracker's noise at a large swing."""
+    env = np.exp(lam * u)
+    phase = w * u + 0.5 * chirp * u * u
+    cols = [np.ones_like(u)]
+    for n in range(1, harmonics + 1, 2):
+        cols += [env * np.cos(n * phase), env * np.sin(n * phase)]
+    return np.column_stack(cols)
+
+
+def highest_harmonic(samples_per_cycle: float) -> int:
+    """The highest odd harmonic a window can hold: the seventh where a cycle has 24 samples or more,
+    the fifth from 16 (a symmetric oscillator's waveform at 1 rad holds ~1e-2 of third, ~1e-4 of fifth,
+    ~1e-6 of seventh), the third from 8, the fundamental alone below."""
+    return 7 if samples_per_cycle >= 24 else 5 if samples_per_cycle >= 16 else 3 if samples_per_cycle >= 8 else 1
+
+
+def baseline_of(tau: np.ndarray, cyc: Cycles) -> np.ndarray:
+    """The slow offset under the oscillation at every sample: the good cycles' offsets smoothed over
+    :data:`_BASELINE_CYCLES` cycles either side (:func:`smooth`), held beyond the ends."""
+    g = cyc.good
+    x = cyc.centre[g]
+    if len(x) < 2:
+        return np.full(len(tau), float(np.median(cyc.offset[g])) if g.any() else 0.0)
+    width = _BASELINE_CYCLES * float(np.median(np.diff(x)))
+    at = np.linspace(x[0], x[-1], max(2, 4 * len(x)))
+    return np.interp(tau, at, smooth(x, cyc.offset[g], at, width))
+
+
+def smooth(x: np.ndarray, y: np.ndarray, at: np.ndarray, width: float, degree: int = 1) -> np.ndarray:
+    """Local polynomial regression (``degree`` 1 or 2) of ``y`` on ``x`` at the points ``at`` with
+    tricube weights over +- ``width``: a running straight line (exact for a linear trend) or parabola
+    (its bias a fourth-order term in width: a decaying amplitude's curvature does not bias it), where
+    too few points are in reach the lower degree."""
+    d = x[None, :] - at[:, None]
+    u = np.abs(d) / width
+    w = np.where(u < 1.0, (1.0 - u**3) ** 3, 0.0)
+    out = np.empty(len(at))
+    for i in range(len(at)):
+        keep = w[i] > 0.0
+        k = min(degree, int(keep.sum()) - 1)
+        if k < 0:
+            out[i] = float(np.interp(at[i], x, y))
+            continue
+        basis = np.vander(d[i, keep] / width, k + 1, increasing=True)
+        sw = np.sqrt(w[i, keep])
+        out[i] = np.linalg.lstsq(basis * sw[:, None], y[keep] * sw, rcond=None)[0][0]
+    return out

@@ -1,0 +1,410 @@
+"""The phases' law: every measured cycle's phase on one curve, Phi(t) = phi0 + omega0 int dt / (R E D).
+
+Steps 4 and 5 of the record fit (:mod:`.fit`). The cycles (:mod:`.cycles`) each give a phase and an
+amplitude; :class:`Model` asks one thing of all of them together, the rig's amplitude law: A(t) the
+peak amplitude (the cycles' amplitudes through the waveform the record shows, ln A a Chebyshev series
+of the degree an F test allows: :class:`_Envelope`), R the ideal law (:mod:`.law`), E = 1 + ds A^2 +
+dq A^4 + d6 A^6 the real rig's excess with Gaussian priors, D the damping's shift of the frequency
+(:mod:`.damping`). Weighted least squares gives omega0 = 2 pi / T0 and the excess; the covariance is
+the block sandwich of :mod:`.spread` plus what the envelope's own uncertainty adds, the priors' part
+apart, and a delete-a-group jackknife (:meth:`Model.jackknife`) checks it. The learned law's own doubts
+(its extrapolation to zero swing, a law no rig has) are measured by refitting (:meth:`Model.check_law`).
+The law's local frequency and decay are what the next pass's windows are fitted with (:meth:`Model.local`).
+"""
+
+from __future__ import annotations
+
+import copy
+import math
+
+import numpy as np
+
+from .cycles import Cycles
+from .damping import damping_of, damping_shift
+from .law import AmplitudeLaw, Table
+from .read import MIN_CYCLES
+from .spread import sandwich, white_and_blocks
+
+JACKKNIFE_GROUPS = 20  # groups of cycles of the jackknife (Model.jackknife): its variance has ~19 dof
+_PHASE_Z = 6.0  # a cycle's phase this many robust sigmas off the law: a slip (left out)
+# ... and this far in rad: a tracker's jump moves a window's phase by a good part of a radian, where
+# what the law's few terms leave at the largest swings of a clean record is ~1e-3 rad
+_SLIP_FLOOR = 0.02
+_GRID_PER_CYCLE = 8  # integration points of the law's phase integral per cycle (trapezoid, smooth)
+_ENVELOPE_DEGREE = 8  # at most: ln A of a decay to a third of the start over the record needs ~5
+_ENVELOPE_F = 9.0  # one more term of the envelope must lower chi^2 by this times the residual variance
+# The real law's excess E = 1 + ds A^2 + dq A^4 + d6 A^6: a stronger cubic restoring term alone already
+# gives all three (over 0.4..1.25 rad, A^2 and A^4 alone leave 2e-4 of it, enough to bias T0 by 1e-4).
+EXCESS_TERMS = ("ds", "dq", "d6")
+# A record whose T(A) asks for an excess this many prior sigmas from the ideal law at some amplitude it
+# swung through follows no rig's law (real ones differ by up to 30-40 %, about one prior sigma): a mode
+# close to the torsion's frequency beating in (its slow phase wobble reads as a chirp), or a rig file
+# whose law is wrong. Either T0, the one learned or the one under the ideal law, may then be the right
+# one: their difference enters T0's sigma (:meth:`Model.check_law`) and the fit says so (``Law.conflict``).
+# Learned alone from a gyro record with a mode 3 % from the torsion's, T0 came out 1.4 % off at 5 sigma.
+LAW_CONFLICT = 3.0
+_HELD = 1e-6  # a held excess's prior sd, relative to the prior's own: the data cannot move it
+
+
+class Model:
+    """The phases' law (module docstring; :mod:`.fit`, step 4) fitted to the good cycles of a pass.
+
+    The amplitude the law is evaluated at is measured with noise too: it is a smooth envelope fitted to
+    the cycles' amplitudes alone (:class:`_Envelope`), and what its uncertainty does to T0 is added to
+    the covariance (:meth:`_covariance`).
+    """
+
+    def __init__(self, law: AmplitudeLaw, kind: str, prior: float, max_amplitude: float | None):
+        self.law, self.kind, self.prior, self.max_amplitude = law, kind, prior, max_amplitude
+        self.omega0 = None
+        self.table: Table | None = None
+        self.parent: Model | None = None  # a jackknife refit's: its damping shift and start are the parent's
+        self.held = False  # the excess held at the ideal law (:meth:`check_law`'s fit)
+        self.terms = len(EXCESS_TERMS)  # the excess terms free: the rest held at zero (:meth:`check_law`)
+        self.order_shift = 0.0  # omega0 learned less omega0 with one excess term fewer (rad/s)
+        self.conflict = 0.0  # the largest excess of the last fit, in prior sigmas
+        self.held_shift = 0.0  # omega0 learned less omega0 under the ideal law (rad/s), past LAW_CONFLICT
+
+    def _table(self, omega: float, largest: float) -> Table:
+        """The law's table at ``omega`` up to ``largest`` rad, recomputed when omega moves by over 1e-6
+        of itself: the exact law's R depends on it through lam omega^2 (d R / d ln omega = eps A^2 / 2
+        < 0.1 for any rig's eps and A < 1.4 rad), so R stays right to 1e-7."""
+        key = getattr(self, "_key", None)
+        if key is None or abs(key[0] / omega - 1.0) > 1e-6 or key[1] < largest:
+            self._key, self._cached = (omega, largest), self.law.table(omega, largest)
+        return self._cached
+
+    def fit(self, cyc: Cycles, slips: bool = False) -> None:
+        """Fit the good cycles; with ``slips``, cycles whose phase is far off the law are left out
+        (the tracker jumped) and the rest refitted."""
+        good = cyc.good & np.isfinite(cyc.phase)
+        for _ in range(3):
+            if good.sum() < MIN_CYCLES:
+                raise ValueError(f"{int(good.sum())} cycles could be measured on their own; at least "
+                                 f"{MIN_CYCLES} are needed")
+            self._solve(cyc, good)
+            if not slips:
+                break
+            z = self.residual / np.sqrt(self.var)
+            robust = 1.4826 * float(np.median(np.abs(z))) or 1.0
+            slip = (np.abs(z) > _PHASE_Z * max(robust, 1.0)) & (np.abs(self.residual) > _SLIP_FLOOR)
+            if not slip.any():
+                break
+            for k in np.flatnonzero(good)[slip]:
+                cyc.good[k] = False
+                cyc.reason[k] = "phase slips off the law (the tracker jumped)"
+            good = cyc.good & np.isfinite(cyc.phase)
+
+    def _solve(self, cyc: Cycles, good: np.ndarray) -> None:
+        centre, var = cyc.centre[good], cyc.phase_var[good]
+        n = len(centre)
+        # the cycles' peak amplitudes (signal units; of the angle for a rate) and their ln variances
+        a1 = cyc.fundamental[good] / (cyc.omega[good] if self.kind == "rate" else 1.0)
+        shape = _waveform(a1, cyc.peak_ratio[good])
+        peak_data = a1 * (1.0 + shape[0] * a1**2 + shape[1] * a1**4)
+        log_sd = np.sqrt(cyc.amplitude_var[good]) / cyc.fundamental[good]
+        grid = _phase_grid(centre)
+        envelope = _Envelope(centre, np.log(peak_data), log_sd)
+        b_grid = envelope.basis(grid)
+        amp_grid = np.exp(b_grid @ envelope.beta)
+        omega = float(np.median(cyc.omega[good])) if self.omega0 is None else self.omega0
+        largest = float(amp_grid.max())
+        law_on = self.law.kind != "linear"
+        kappa_max = None
+        if self.kind == "proportional":
+            kappa_max = self.max_amplitude / largest if self.max_amplitude is not None else None
+            largest_rad = self.max_amplitude or 0.0
+        else:
+            largest_rad = largest
+        s = self.law.coefficient(omega)
+        if law_on:
+            self.table = self._table(omega, 1.05 * largest_rad)
+        phase = self.unwrap(cyc, good, grid)
+        names = ["phi", "omega"]
+        start = [0.0, omega]
+        priors = []  # (index, centre, sd)
+        if law_on and self.prior > 0.0:
+            names += list(EXCESS_TERMS)
+            start += [0.0] * len(EXCESS_TERMS)
+            priors += [(2 + j, 0.0, (_HELD if self.held or j >= self.terms else 1.0) * self.prior * abs(s))
+                       for j in range(len(EXCESS_TERMS))]
+        if law_on and kappa_max is not None:
+            names.append("kappa")
+            start.append(0.5 * kappa_max)
+            priors.append((len(names) - 1, 0.5 * kappa_max, kappa_max / math.sqrt(12.0)))
+        ref = float(np.average(centre, weights=1.0 / var))
+        at = np.searchsorted(grid, centre)
+        at_ref = float(np.interp(ref, grid, np.arange(len(grid))))
+        weights = 1.0 / np.sqrt(var)
+        # the damping's own lengthening of the period, second order in it (:func:`damping_shift`)
+        if self.parent is None:
+            damping = damping_of(grid, amp_grid, omega)
+            shift = damping_shift(damping, amp_grid)
+        else:  # a ~1e-5 effect that leaving out a group of cycles moves by a few % of itself
+            damping = self.parent.damping
+            shift = np.interp(amp_grid, *self.parent.shift_curve)
+        order = np.argsort(amp_grid)
+        self.shift_curve = (amp_grid[order], shift[order])
+        slow = 1.0 / (1.0 + shift)
+
+        def terms(p):
+            """(amplitude A(t) in rad on the grid, 1 / (R E D), d(1 / (R E D)) / d ln a, and its
+            derivatives in the law's parameters)."""
+            amp = amp_grid
+            if not law_on:
+                return amp, slow, np.zeros_like(amp), []
+            kappa = p[names.index("kappa")] if "kappa" in names else 1.0
+            a = np.minimum(kappa * amp, self.table.largest)
+            a2 = a * a
+            d = p[2:2 + len(EXCESS_TERMS)] if "ds" in names else np.zeros(len(EXCESS_TERMS))
+            powers = [a2 ** (j + 1) for j in range(len(EXCESS_TERMS))]
+            excess = 1.0 + sum(dj * pw for dj, pw in zip(d, powers))
+            growth = sum(2.0 * (j + 1) * dj * a2**j for j, dj in enumerate(d))  # dE/da / a
+            ratio = self.table.ratio_at(a)
+            g = slow / (ratio * excess)
+            dg_da = -g * (self.table.ratio_slope(a) / ratio + growth * a / excess)
+            dg_dlna = a * dg_da
+            slopes = [-g * pw / excess for pw in powers] if "ds" in names else []
+            if "kappa" in names:  # d g / d kappa = A d g / d a: finite at kappa = 0, where a is 0
+                slopes.append(amp * dg_da)
+            return a, g, dg_dlna, slopes
+
+        def integral(f):
+            cum = np.concatenate([np.zeros((1,) + f.shape[1:]),
+                                  np.cumsum(0.5 * (f[1:] + f[:-1]) * np.diff(grid).reshape((-1,) + (1,) * (f.ndim - 1)),
+                                           axis=0)])
+            return cum[at] - _interp_rows(at_ref, cum)
+
+        def evaluate(p):
+            _, g, dg, slopes = terms(p)
+            big = integral(g)
+            r_phase = (phase - p[0] - p[1] * big) * weights
+            cols = [-np.ones(n), -big] + [-p[1] * integral(d) for d in slopes]
+            j_phase = np.column_stack(cols) * weights[:, None]
+            j_envelope = -p[1] * integral(dg[:, None] * b_grid) * weights[:, None]
+            rp = np.array([(p[i] - c) / sd for i, c, sd in priors])
+            jp = np.zeros((len(priors), len(p)))
+            for row, (i, _, sd) in enumerate(priors):
+                jp[row, i] = 1.0 / sd
+            return r_phase, j_phase, j_envelope, rp, jp
+
+        # Gauss-Newton with the analytic Jacobian: phi0 and omega0 enter linearly, the rest nearly so; a
+        # record at one amplitude leaves a direction to the priors alone, which finite differences of a
+        # residual weighted by 1 / sigma_phase would drown in rounding.
+        p = np.array(start, dtype=float)
+        if self.parent is not None:
+            p = self.parent.params.copy()
+        p[0] = float(np.average(phase - p[1] * integral(terms(p)[1]), weights=weights**2))
+        for _ in range(40):
+            r_phase, j_phase, _, rp, jp = evaluate(p)
+            jac = np.vstack([j_phase, jp])
+            res = np.concatenate([r_phase, rp])
+            col = np.maximum(np.linalg.norm(jac, axis=0), 1e-300)
+            step = -np.linalg.lstsq(jac / col, res, rcond=None)[0] / col
+            new = p + step
+            new[1] = min(max(new[1], 0.5 * omega), 2.0 * omega)
+            if "kappa" in names:
+                new[names.index("kappa")] = max(new[names.index("kappa")], 0.0)
+            done = abs(new[1] - p[1]) <= 1e-14 * p[1] and np.all(np.abs(step[2:]) <= 1e-12 * (1.0 + np.abs(p[2:])))
+            p = new
+            if done:
+                break
+        r_phase, j_phase, j_envelope, rp, jp = evaluate(p)
+        a_fit, g_fit, _, _ = terms(p)
+        self.names, self.params, self.omega0 = names, p, float(p[1])
+        if "ds" in names and not self.held:  # the excess at each amplitude swung through, in prior sigmas
+            powers = np.array([(a_fit * a_fit) ** (j + 1) for j in range(len(EXCESS_TERMS))])
+            sd = self.prior * abs(s) * np.sqrt(np.sum(powers**2, axis=0))
+            self.conflict = float(np.max(np.abs(p[2:2 + len(EXCESS_TERMS)] @ powers) / np.maximum(sd, 1e-300)))
+        self.residual, self.var = r_phase / weights, var
+        self.ideal = s if law_on else None
+        self.damping = damping
+        self.scale_known = self.kind != "proportional" or "kappa" in names
+        amp_signal = amp_grid
+        slope = envelope.basis(grid, derivative=1) @ envelope.beta
+        self.fund_at = lambda tt: np.interp(tt, grid, amp_signal)
+        self.peak_at = (lambda tt: np.interp(tt, grid, a_fit)) if law_on else (lambda tt: None)
+        self.rate_at = lambda tt: np.interp(tt, grid, g_fit)
+        self.decay_at = lambda tt: np.interp(tt, grid, slope)
+        cum = np.concatenate([[0.0], np.cumsum(0.5 * (g_fit[1:] + g_fit[:-1]) * np.diff(grid))])
+        cum = cum - float(np.interp(at_ref, np.arange(len(grid)), cum))
+        self.phase_integral = (grid, cum, float(p[0]), float(p[1]), float(g_fit[0]), float(g_fit[-1]))
+        self._covariance(j_phase, jp, r_phase, j_envelope, envelope.cov)
+
+    def unwrap(self, cyc: Cycles, good: np.ndarray, grid: np.ndarray) -> np.ndarray:
+        """The good cycles' phases made continuous: each one within pi of its predecessor advanced by
+        the local frequency over the time between them."""
+        centre, phase, omega = cyc.centre[good], cyc.phase[good], cyc.omega[good]
+        out = np.empty(len(phase))
+        out[0] = phase[0]
+        for k in range(1, len(phase)):
+            advance = 0.5 * (omega[k] + omega[k - 1]) * (centre[k] - centre[k - 1])
+            predicted = out[k - 1] + advance
+            out[k] = phase[k] + 2.0 * math.pi * round((predicted - phase[k]) / (2.0 * math.pi))
+        return out
+
+    def _covariance(self, jd, jp, r, j_envelope, cov_envelope) -> None:
+        """:mod:`.fit`, step 5: white, block sandwich (at least the white one), the priors', and
+        what the envelope's own uncertainty adds (a two-step estimate's correction, Murphy and Topel:
+        H^-1 (J^T J_A) V_A (J_A^T J) H^-1, J_A the phases' response to the envelope's coefficients)."""
+        hessian = jd.T @ jd + jp.T @ jp
+        # equilibrated before the inverse: the columns differ by ~1e3 in scale (phase, omega0 times the
+        # record's span, the excess times A^2), and at a nearly constant swing the direction only the
+        # priors fix has ~1e-10 of the largest curvature, which pinv's cut would otherwise round away
+        scale = 1.0 / np.sqrt(np.maximum(np.diag(hessian), 1e-300))
+        bread_inv = scale[:, None] * np.linalg.pinv(scale[:, None] * hessian * scale[None, :]) * scale[None, :]
+        stat_white, stat_sand, block = white_and_blocks(jd, r, bread_inv)
+        cross = jd.T @ j_envelope
+        envelope = bread_inv @ cross @ cov_envelope @ cross.T @ bread_inv
+        self.block = block
+        self.cov_white = bread_inv @ (jd.T @ jd) @ bread_inv
+        self.cov_stat = (stat_sand if stat_sand[1, 1] > stat_white[1, 1] else stat_white) + envelope
+        self.cov_law = bread_inv @ (jp.T @ jp) @ bread_inv
+        # T0's response to the law's prior being off by one sigma in each of its excess terms (their rows
+        # come first): records of one rig share that error, while a proportional record's scale is its own
+        law_rows = len(EXCESS_TERMS) if "ds" in self.names else 0
+        self.prior_gain = (bread_inv @ jp.T)[1, :law_rows]
+
+    def check_law(self, cyc: Cycles) -> None:
+        """Two doubts of the learned law that T0's sigma carries (:func:`.fit._result`: the first where it
+        is more than the sigma already holds), each the same cycles refitted: :attr:`order_shift`,
+        omega0 as fitted less omega0 with the excess's last term held at zero, and past
+        :data:`LAW_CONFLICT` :attr:`held_shift`, omega0 less omega0 with the whole excess held at the
+        ideal law.
+
+        The first is the extrapolation's: a record whose swing spans a narrow range (a lightly damped
+        rig from 1.2 rad to 1.05) gives the law's value, slope and curvature there so precisely that
+        the three terms seem determined, and their extrapolation to zero swing turns a 1e-5 misfit of
+        the law's shape into 1.5e-3 of T0 (6-8 sigma of the covariance's, which only counts the
+        noise); with one term fewer, where the record does determine the law, the two agree to a
+        fraction of their sigma."""
+        self.held_shift = self.order_shift = 0.0
+        if "ds" in self.names and not self.held:
+            fewer = copy.copy(self)  # _solve rebinds its results: the shallow copy keeps this fit's
+            fewer.terms = len(EXCESS_TERMS) - 1
+            fewer._solve(cyc, cyc.good & np.isfinite(cyc.phase))
+            self.order_shift = self.omega0 - fewer.omega0
+        if self.conflict <= LAW_CONFLICT:
+            return
+        held = copy.copy(self)
+        held.held = True
+        held._solve(cyc, cyc.good & np.isfinite(cyc.phase))
+        self.held_shift = self.omega0 - held.omega0
+
+    def integral_at(self, tt: np.ndarray) -> np.ndarray:
+        """int dt / (R E D) from the reference time to ``tt`` (s), carried on at the end rates beyond the
+        first and last cycle: the phase is phi0 + omega0 times this."""
+        grid, cum, _, _, g0, g1 = self.phase_integral
+        inside = np.interp(tt, grid, cum)
+        inside = np.where(tt < grid[0], cum[0] + g0 * (tt - grid[0]), inside)
+        return np.where(tt > grid[-1], cum[-1] + g1 * (tt - grid[-1]), inside)
+
+    def phase_at(self, tt: np.ndarray) -> np.ndarray:
+        """The fitted law's phase Phi at times ``tt`` (the cycles' fundamental is A cos Phi)."""
+        _, _, phi, omega, _, _ = self.phase_integral
+        return phi + omega * self.integral_at(tt)
+
+    def law_induced_variance(self) -> float:
+        """The variance of omega0 that the law's parameters carry (their own uncertainty, the record's and
+        the priors'): Sigma_wL Sigma_LL^-1 Sigma_Lw of the whole covariance, the part a fit holding the
+        law at its estimate does not see."""
+        law = [i for i, n in enumerate(self.names) if n in EXCESS_TERMS or n == "kappa"]
+        if not law:
+            return 0.0
+        cov = self.cov_stat + self.cov_law
+        cross = cov[1, law]
+        return float(cross @ np.linalg.pinv(cov[np.ix_(law, law)]) @ cross)
+
+    def jackknife(self, cyc: Cycles) -> tuple[float, int]:
+        """(variance of omega0, groups): the delete-a-group jackknife of this fit over up to
+        :data:`JACKKNIFE_GROUPS` contiguous groups of the good cycles, each refitted whole (waveform,
+        envelope and phases). It sees every path by which a record's noise reaches omega0, those the
+        covariance models (the phases, the envelope) and those it does not (noise correlated within
+        a cycle, which moves phase, amplitude and waveform together; the law's shape misfit), which
+        on records with tracking noise correlated over a fraction of a cycle leaves the covariance
+        ~2x short (tests/test_record_sigma.py)."""
+        good = np.flatnonzero(cyc.good & np.isfinite(cyc.phase))
+        groups = min(JACKKNIFE_GROUPS, len(good))
+        if groups < 5:
+            return 0.0, 0
+        omegas = []
+        if self.law.kind != "linear":  # the refits' table: at their starting omega0, and room for
+            self._table(self.omega0, 1.2 * self._key[1])  # an envelope a little higher without a group
+        for part in np.array_split(good, groups):
+            keep = cyc.good & np.isfinite(cyc.phase)
+            keep[part] = False
+            refit = copy.copy(self)  # _solve rebinds its results: the shallow copy keeps this fit's
+            refit.parent = self
+            refit._solve(cyc, keep)
+            omegas.append(refit.omega0)
+        omegas = np.array(omegas)
+        return float((groups - 1) / groups * np.sum((omegas - omegas.mean()) ** 2)), groups
+
+    def local_omega(self, tt: np.ndarray) -> np.ndarray:
+        """The instantaneous frequency (rad/s) the fitted law gives at times ``tt``."""
+        return self.omega0 * self.rate_at(tt)
+
+    def local(self, tt: np.ndarray):
+        """(instantaneous frequency, d ln(amplitude) / dt) at times ``tt``: what the next pass's windows
+        are fitted with."""
+        return self.local_omega(tt), self.decay_at(tt)
+
+
+class _Envelope:
+    """ln A(t) of the cycles' amplitudes as a Chebyshev series in the time scaled to [-1, 1], of the
+    lowest degree past which one more term does not lower chi^2 by :data:`_ENVELOPE_F` times the
+    residual variance (an F test at ~3 sigma), at most :data:`_ENVELOPE_DEGREE`: as smooth as the decay
+    the record shows and no smoother. Fitted to the amplitudes alone: let the phases move it and their
+    noise would pass for a law through it (an error in the regressor attenuates what it regresses).
+    ``cov``: the coefficients' covariance, scaled by chi^2 per degree of freedom where that is above 1."""
+
+    def __init__(self, t: np.ndarray, log_a: np.ndarray, sd: np.ndarray):
+        self.t0, self.t1 = float(t[0]), float(t[-1])
+        n = len(t)
+        best = None
+        for degree in range(0, min(_ENVELOPE_DEGREE, n - 2) + 1):
+            x = self.basis(t, degree=degree) / sd[:, None]
+            beta, *_ = np.linalg.lstsq(x, log_a / sd, rcond=None)
+            r = log_a / sd - x @ beta
+            chi = float(r @ r)
+            dof = max(n - degree - 1, 1)
+            if best is not None and best[2] - chi < _ENVELOPE_F * chi / dof:
+                break
+            best = (degree, beta, chi, dof, x)
+        self.degree, self.beta, chi, dof, x = best
+        self.cov = sandwich(x, log_a / sd - x @ self.beta)
+
+    def basis(self, t: np.ndarray, derivative: int = 0, degree: int | None = None) -> np.ndarray:
+        from numpy.polynomial import chebyshev as C
+
+        degree = self.degree if degree is None else degree
+        half = max(0.5 * (self.t1 - self.t0), 1e-300)
+        u = np.clip((np.asarray(t) - 0.5 * (self.t0 + self.t1)) / half, -1.0, 1.0)
+        cols = []
+        for k in range(degree + 1):
+            c = np.zeros(k + 1)
+            c[k] = 1.0
+            cols.append(C.chebval(u, C.chebder(c, derivative) if derivative else c) / half**derivative)
+        return np.column_stack(cols)
+
+
+def _waveform(a1: np.ndarray, peak_ratio: np.ndarray) -> np.ndarray:
+    """(c1, c2) of peak / fundamental = 1 + c1 a1^2 + c2 a1^4, least squares over the cycles: the real
+    rig's waveform, measured on the record (its harmonics are its law's, not the ideal law's: at 1.2 rad
+    they differ by ~excess x 1 %, which moves A by 1e-4 and T0 with it)."""
+    if len(a1) < 3:
+        return np.zeros(2)
+    return np.linalg.lstsq(np.column_stack([a1**2, a1**4]), peak_ratio - 1.0, rcond=None)[0]
+
+
+def _interp_rows(at: float, cum: np.ndarray):
+    """``cum`` (rows on a grid index) interpolated at fractional row ``at``."""
+    i = min(int(at), len(cum) - 2)
+    f = at - i
+    return (1.0 - f) * cum[i] + f * cum[i + 1]
+
+
+def _phase_grid(centre: np.ndarray) -> np.ndarray:
+    """The cycles' centres with :data:`_GRID_PER_CYCLE` - 1 points between neighbours."""
+    parts = [np.linspace(a, b, _GRID_PER_CYCLE, endpoint=False) for a, b in zip(centre[:-1], centre[1:])]
+    return np.concatenate(parts + [centre[-1:]])
