@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import math
 import os
+import re
 import stat
 import tomllib
 from pathlib import Path
@@ -69,6 +70,14 @@ def read_toml(path: str | Path) -> dict:
         raise RigError(src, "toml", "nested too deeply (arrays or tables within each other)") from None
     except ValueError as exc:  # e.g. an integer of more than 4300 digits (Python's conversion limit)
         raise RigError(src, "toml", f"not usable ({exc})") from None
+
+
+def rig_name(data: dict, source: str, default_name: str) -> str:
+    """The file's ``name`` (it names output files: letters, digits, '_', '-', '.'), else ``default_name``."""
+    name = data.get("name", default_name)
+    if not isinstance(name, str) or not re.fullmatch(r"[A-Za-z0-9_.-]+", name) or name.startswith("."):
+        raise RigError(source, "name", "must be letters, digits, '_', '-' or '.' (it names output files)")
+    return name
 
 
 def required(table: dict, key: str, source: str, prefix: str):

@@ -19,6 +19,7 @@ from pathlib import Path
 import numpy as np
 
 from bifilar.rig.air import Air, air_from_dict
+from bifilar.rig.hinge import HINGE_TABLES, HingeRig, hinge_from_dict
 from bifilar.rig.ranges import MAX_WIRES, check_ranges
 from bifilar.rig.checks import (
     RigError,
@@ -28,6 +29,7 @@ from bifilar.rig.checks import (
     positive,
     read_toml,
     required,
+    rig_name,
     table,
     vector3,
 )
@@ -103,25 +105,32 @@ _INITIAL_KEYS = {"rotation", "omega"}
 _UNCERTAINTY_KEYS = set(Uncertainty.__dataclass_fields__)
 
 
-def load_rig(path: str | Path, free_moment: int | None = None) -> Rig:
+def load_rig(path: str | Path, free_moment: int | None = None, hinge: bool = False) -> Rig | HingeRig:
     """Read and check a rig file; raise :class:`RigError` on any problem.
 
     ``free_moment`` (0, 1, 2): the diagonal inertia entry being identified, which may be ``nan`` or
     any positive start value (:func:`bifilar.rig.checks.inertia_tensor`); a ``nan`` stays in the
-    returned tensor for the caller to fill.
+    returned tensor for the caller to fill. ``hinge``: whether the caller takes a hinge rig
+    (:mod:`bifilar.rig.hinge`, a file with ``[pivot]`` or ``[torsion]``); without it such a file is
+    refused in one line, so a tool made for wires never meets a rig without them.
     """
     data = read_toml(path)
     return rig_from_dict(data, source=str(path), default_name=re.sub(r"[^A-Za-z0-9_.-]", "_", Path(path).stem),
-                         free_moment=free_moment)
+                         free_moment=free_moment, hinge=hinge)
 
 
-def rig_from_dict(data: dict, source: str = "<memory>", default_name: str = "rig", free_moment: int | None = None) -> Rig:
+def rig_from_dict(data: dict, source: str = "<memory>", default_name: str = "rig", free_moment: int | None = None,
+                  hinge: bool = False) -> Rig | HingeRig:
     """Build a checked :class:`Rig` from the parsed TOML table (see the module docstring and
-    :func:`load_rig` for ``free_moment``)."""
+    :func:`load_rig` for ``free_moment`` and ``hinge``; a hinge rig's unknown moment is the one about its
+    axis, so ``free_moment`` is for wire rigs only)."""
+    kind = next((k for k in HINGE_TABLES if k in data), None)
+    if kind is not None:
+        if not hinge:
+            raise RigError(source, kind, "a hinge rig (compound or torsion pendulum): this tool takes wire rigs only")
+        return hinge_from_dict(data, source, default_name)
     no_unknown(data, _TOP_KEYS, source, "")
-    name = data.get("name", default_name)
-    if not isinstance(name, str) or not re.fullmatch(r"[A-Za-z0-9_.-]+", name) or name.startswith("."):
-        raise RigError(source, "name", "must be letters, digits, '_', '-' or '.' (it names output files)")
+    name = rig_name(data, source, default_name)
     gravity = positive(data.get("gravity", 9.81), source, "gravity")
 
     body = table(data, "body", source, mandatory=True)

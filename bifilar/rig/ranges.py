@@ -26,6 +26,7 @@ RANGES = {
     "wire[i].axial_stiffness": (1.0, 1e10, "N", "E A: from a thin rubber cord to a 10 cm steel bar"),
     "wire[i].linear_density": (0.0, 10.0, "kg/m", "positive, up to a 4 cm steel rope's; heavy wires: docs/heavy-wires.md"),
     "coordinates": (-1e4, 1e4, "m", "every component of anchor, attach and com"),
+    "torsion.stiffness": (1e-6, 1e5, "N m/rad", "from a silk fibre to a 5 cm steel bar a metre long"),
     "air.density": (1e-3, 2e3, "kg/m^3", "from thin air to twice water's"),
     "air.viscosity": (0.0, 10.0, "Pa s", "0 (inviscid) to ten thousand times water's"),
     "air.drag": (0.0, 100.0, "", "MuJoCo's coefficients are O(1)"),
