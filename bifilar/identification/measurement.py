@@ -9,10 +9,11 @@ measurements of an assembly and of its fixture alone into the object's own momen
 docs/identification.md); the CLI, the HTML page and the tensor's hangings read the typed fields.
 
 The steps are those of docs/identification.md: a ``nan`` moment gets a start value (:func:`start_moment`),
-the air is left out of the model (the moment found is the apparent one), the rig is linearised once
+the air's drag is left out of the model and its added mass kept (the moment found is the body's own;
+the apparent one, with the air's added moment, is reported beside it), the rig is linearised once
 (:func:`bifilar.identification.identify.pencil`), the period is taken to zero amplitude (the amplitude
 law's fixed point for a timed period, the records' fits for records), inverted and propagated
-(:mod:`bifilar.identification.propagation`); with an ``[air]`` table the body's own moment is added.
+(:mod:`bifilar.identification.propagation`).
 """
 
 from __future__ import annotations
@@ -25,7 +26,7 @@ import numpy as np
 
 from bifilar.rig import Rig, RigError
 
-from .air import vacuum, without_air
+from .air import added_moment, still, with_air
 from .identify import axis_vector, identify, invert_period, pencil, with_moment
 from .propagation import budget, linear_axes, monte_carlo
 from .records.pipeline import Pooled, RecordOptions, Trial, identify_records
@@ -103,7 +104,7 @@ class Measurement:
     ``std`` is the propagated standard deviation (None where nothing was: the rig file states no
     sigma), ``std_repeatability`` its part from the period, ``std_rig`` from the rig's geometry and
     mass; ``period`` (s) is the zero-amplitude period inverted, ``timed_period`` the one given at
-    ``amplitude`` (rad) where that differs; ``sensitivity`` is d ln T / d ln I. ``budget`` maps each
+    ``amplitude`` (rad) where that differs; ``sensitivity`` is d ln T / d ln I (of the apparent moment in air). ``budget`` maps each
     uncertainty group to its share of var(I) (``budget_per_mass``: of var(I / m)). ``trials`` are the
     records' fits (empty for a period), ``pooled`` their pooled period. ``air`` is the body's own moment
     where the rig has an ``[air]`` table. ``tare`` and ``object_part`` are set by :func:`subtract_tare`.
@@ -212,7 +213,8 @@ def measure(rig: Rig, axis: str, *, period: float | None = None, amplitude: floa
     be used, :class:`bifilar.identification.records.bounds.WorkSpent` once ``options.max_seconds`` is spent.
     """
     rig_in_air, was_nan = _started(rig, axis)
-    rig = vacuum(rig_in_air)  # the moment identified is the apparent one, the air's included
+    rig = still(rig_in_air)  # the moment identified is the body's own: the air's added mass is in the model
+    added = added_moment(rig, axis_vector(axis))  # reported: the apparent moment, the body's + the air's
     flags: list[str] = []
     p = pencil(rig, axis)  # the rig's one rest-pose search: everything below is about this rest pose
     trials: tuple[Trial, ...] = ()
@@ -232,7 +234,7 @@ def measure(rig: Rig, axis: str, *, period: float | None = None, amplitude: floa
         if not pooled.consistent:
             flags.append(f"the {len(trials)} trials scatter more than their stated sigmas (chi^2 per degree of "
                          f"freedom {pooled.chi2_per_dof:.3g}): the pooled sigma is scaled by its square root")
-    result = _propagate(rig, axis, small, small_std, samples, flags, p)
+    result = _propagate(rig, axis, small, small_std, samples, flags, p, added)
     result = replace(result, period_std_source=std_source,
                      start_value="nan in the rig file" if was_nan else "the rig file's value (a start only)",
                      amplitude=(amplitude, amplitude) if amplitude and signals is None else None,
@@ -240,9 +242,9 @@ def measure(rig: Rig, axis: str, *, period: float | None = None, amplitude: floa
                      trials=trials, pooled=pooled)
     if rig_in_air.air is None:
         return result
-    # The body's own moment: the air's added moment subtracted. The air is no rigid body: the apparent
-    # tensor may break the triangle inequality; the body's must not.
-    own = without_air(rig_in_air, axis_vector(axis), result.inertia, result.std or 0.0)
+    # The body's own moment. The air is no rigid body: the apparent tensor may break the triangle
+    # inequality; the body's must not.
+    own = with_air(rig, axis_vector(axis), result.inertia - added, result.std or 0.0)
     check = tensor_check(with_moment(rig, axis, own.inertia).inertia)
     flags = result.flags
     if check.body:
@@ -253,17 +255,19 @@ def measure(rig: Rig, axis: str, *, period: float | None = None, amplitude: floa
 _NO_BODY = "the identified tensor"  # how the flag of a tensor no body has starts
 
 
-def _propagate(rig: Rig, axis: str, period: float, period_std: float, samples, flags: list, p) -> Measurement:
+def _propagate(rig: Rig, axis: str, period: float, period_std: float, samples, flags: list, p,
+               added: float = 0.0) -> Measurement:
     """The propagated moment and everything derived from it (per mass, checks, flags); ``p`` is the
-    rig's pencil about ``axis`` (its rest pose and linearisation). The fields :func:`measure` sets after
-    are left at placeholders."""
+    rig's pencil about ``axis`` (its rest pose and linearisation); ``added``: the air's added moment
+    about ``axis``, added to the body's to report the apparent moment (its floor check is the body's).
+    The fields :func:`measure` sets after are left at placeholders."""
     found = invert_period(rig, axis, period, p.lin.rest, p)
     geometry = [g for g in ("length", "anchor", "attach", "mass", "com") if getattr(rig.uncertainty, g) > 0.0]
     if samples and (geometry or period_std > 0.0):
         result = monte_carlo(rig, axis, period, period_std, samples, np.random.default_rng(0))
     else:
         result = linear_axes(rig, {axis: period}, period_std, p.lin.rest, {axis: found}, p.lin)[axis]
-    j, m = result.moment, found.rig.mass
+    j, m = result.moment + added, found.rig.mass
     inp = result.inputs
     parts = (result.gradient * inp.std) ** 2
     groups = np.array(inp.groups)
@@ -285,7 +289,7 @@ def _propagate(rig: Rig, axis: str, period: float, period_std: float, samples, f
         flags.append(f"{_NO_BODY} (principal moments {', '.join(f'{x:.6g}' for x in check.principal)}) "
                      f"{'is not positive definite' if not check.positive_definite else 'breaks the triangle inequality'}"
                      ": no body has it (a wrong period, mode or rig file)")
-    if found.sensitivity < WEAK_SENSITIVITY:
+    if found.sensitivity < WEAK_SENSITIVITY:  # the body's own moment's (in air, less than the apparent's)
         flags.append(f"the period hardly depends on this moment (d ln T / d ln I = {found.sensitivity:.3g}): "
                      "its uncertainty is amplified 1/(2 x that) times")
     per_mass = j / m
@@ -293,11 +297,12 @@ def _propagate(rig: Rig, axis: str, period: float, period_std: float, samples, f
     return Measurement(
         rig=rig.name, source=rig.source, axis=axis, mass=rig.mass, com=tuple(rig.com.tolist()), inertia=j,
         std=result.std if propagated else None,
-        interval95=(result.low, result.high) if propagated else None,
+        interval95=(result.low + added, result.high + added) if propagated else None,
         std_repeatability=math.sqrt(rep_var) if period_std > 0.0 else None,
         std_rig=math.sqrt(rig_var) if geometry else None,
         period=period, period_std=period_std if period_std > 0.0 else None, period_std_source="",
-        sensitivity=found.sensitivity, inertia_per_mass=per_mass, std_per_mass=std_pm if propagated else None,
+        sensitivity=found.sensitivity * (j / result.moment if added else 1.0), inertia_per_mass=per_mass,
+        std_per_mass=std_pm if propagated else None,
         radius_of_gyration=k, radius_of_gyration_std=std_pm / (2.0 * k) if propagated and k else None,
         method=result.method, budget=result.budget if propagated else None,
         budget_per_mass=budget(inp, per_mass_gradient) if propagated else None,
