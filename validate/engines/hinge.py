@@ -36,7 +36,7 @@ def check_known(rig: HingeRig) -> None:
     for a torsion rig, the rod's stiffness."""
     if math.isnan(moment_about_axis(rig)):
         raise RigError(rig.source, "body.inertia", "the moment about the hinge axis is unknown (nan): it is what "
-                       "a timed period measures (python -m validate identify); give a value to simulate the rig")
+                       "a timed period measures (python -m validate identify); give a value to simulate or model the rig")
     restoring(rig)  # raises on a torsion rod without a stiffness
 
 
