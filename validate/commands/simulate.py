@@ -35,7 +35,8 @@ def add_parser(subparsers) -> None:
                    help="kane: the hand-derived model (Kane-Tseng for two wires, the N-wire model otherwise; "
                         "stops where a wire goes slack); nwire: the N-wire model on any rig; mujoco: tendon "
                         "cables that may go slack; mujoco-eq: equality cables; mujoco-cable: heavy wires "
-                        "(linear_density) as chains of rigid segments with their mass (default: kane)")
+                        "(linear_density) as chains of rigid segments with their mass; a hinge rig runs on kane "
+                        "(its exact 1-DOF equation) or mujoco (a hinge joint) (default: kane)")
     p.add_argument("--duration", type=bounded_float("--duration", 0.0, MAX_DURATION, "s", low_open=True),
                    required=True, help=f"simulated time, s, > 0 and at most {MAX_DURATION:g}")
     p.add_argument("--dt-out", type=bounded_float("--dt-out", 0.0, 100.0, "s", low_open=True), default=0.01,

@@ -95,6 +95,7 @@ def build_spec(rig: HingeRig, timestep: float = TIMESTEP, scene: bool = False) -
 
 
 def compile_model(rig: HingeRig, timestep: float = TIMESTEP) -> mujoco.MjModel:
+    """:func:`build_spec` compiled."""
     return build_spec(rig, timestep).compile()
 
 
