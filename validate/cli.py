@@ -141,6 +141,8 @@ _LIKELY_FIELD = {
     "bifilar.motion.kane_kernel": "initial",
     "validate.engines.mjcf": "body",
     "validate.engines.mujoco_rig": "initial",
+    "validate.engines.mujoco_hinge": "body.inertia",
+    "validate.engines.hinge": "amplitude",
     "bifilar.identification.propagation": "uncertainty",
     "bifilar.identification.identify": "body.inertia",
     "bifilar.identification.measurement": "body.inertia",

@@ -30,6 +30,14 @@ RIG_CHANNELS = {
     "length_error": (("length_error_1", "length_error_2"), "anchor-attachment distance minus length, m"),
 }
 PER_WIRE = ("tension", "length_error")
+# A hinge rig's CSV (validate.engines.hinge): the body's pose as for a wire rig, then the one coordinate
+# and its rate instead of the wires' columns.
+HINGE_CHANNELS = {
+    "com": RIG_CHANNELS["com"],
+    "quat": RIG_CHANNELS["quat"],
+    "angle": (("angle",), "rotation about the hinge axis from rest, rad (right hand about the axis)"),
+    "rate": (("rate",), "its rate, rad/s"),
+}
 
 
 def rig_columns(n_wires: int = 2) -> dict[str, tuple[str, ...]]:
@@ -125,11 +133,22 @@ def write_rig_csv(traj: Trajectory, path: str | Path) -> None:
     """The rig CSV contract: header :func:`rig_csv_header` (one tension and one length-error column
     per wire), one row per sample, full precision."""
     n_wires = np.asarray(traj["tension"]).reshape(len(traj.t), -1).shape[1]
-    columns = [traj.t[:, None]] + [np.asarray(traj[name]).reshape(len(traj.t), -1) for name in RIG_CHANNELS]
+    _write_csv(traj, path, RIG_CHANNELS, rig_csv_header(n_wires))
+
+
+def write_hinge_csv(traj: Trajectory, path: str | Path) -> None:
+    """A hinge rig's CSV: ``t``, the COM and quaternion columns of the rig CSV, ``angle`` and ``rate``
+    (:data:`HINGE_CHANNELS`), one row per sample, full precision."""
+    _write_csv(traj, path, HINGE_CHANNELS, ("t",) + tuple(c for cols, _ in HINGE_CHANNELS.values() for c in cols))
+
+
+def _write_csv(traj: Trajectory, path: str | Path, names, header: tuple[str, ...]) -> None:
+    """``t`` and the channels ``names`` under ``header``, written whole or not at all."""
+    columns = [traj.t[:, None]] + [np.asarray(traj[name]).reshape(len(traj.t), -1) for name in names]
     table = np.hstack(columns)
     if not np.all(np.isfinite(table)):
         raise NonFiniteTrajectory(f"{path}: trajectory has non-finite values; nothing written")
-    lines = [",".join(rig_csv_header(n_wires))]
+    lines = [",".join(header)]
     lines += [",".join(repr(float(x)) for x in row) for row in table]
     atomic_write_text(path, "\n".join(lines) + "\n")
 

@@ -37,6 +37,7 @@ import numpy as np
 from scipy.integrate import solve_ivp
 from scipy.special import ellipk
 
+from bifilar.motion.simulate import output_grid
 from bifilar.rig.checks import RigError
 from bifilar.rig.hinge import HingeRig
 
@@ -87,7 +88,8 @@ def simulate(rig: HingeRig, amplitude: float, duration: float, dt_out: float,
              rtol: float = 1e-10) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Integrate the equation of motion from rest at theta = ``amplitude`` (rad) for ``duration`` (s) by
     scipy's DOP853 at ``rtol`` (atol 1e-3 of it in rad and rad/s, the angle being O(1)); returns the times
-    (s, every ``dt_out``), the angle (rad) and its rate (rad/s), from the dense output."""
+    (s, every ``dt_out`` up to ``duration``: :func:`bifilar.motion.simulate.output_grid`, the grid of every
+    engine), the angle (rad) and its rate (rad/s), from the dense output."""
     omega2 = restoring(rig) / moment_about_axis(rig)  # (rad/s)^2
     if rig.kind == "pivot":
         def rhs(_t, y):
@@ -95,7 +97,7 @@ def simulate(rig: HingeRig, amplitude: float, duration: float, dt_out: float,
     else:
         def rhs(_t, y):
             return (y[1], -omega2 * y[0])
-    times = np.arange(0.0, duration + 0.5 * dt_out, dt_out)
+    times = output_grid(duration, dt_out)
     sol = solve_ivp(rhs, (0.0, times[-1]), [float(amplitude), 0.0], method="DOP853", rtol=rtol,
                     atol=1e-3 * rtol, t_eval=times)
     return sol.t, sol.y[0], sol.y[1]

@@ -1,5 +1,6 @@
 """``python -m validate mjcf RIG... --out DIR``: MuJoCo models of rigs, ``DIR/<rig>/<rig>.xml`` and
-``DIR/<rig>/scene.xml`` (:mod:`validate.engines.mjcf`); the rigs' names must differ."""
+``DIR/<rig>/scene.xml`` (:mod:`validate.engines.mjcf`; a hinge rig's by :mod:`validate.engines.mujoco_hinge`);
+the rigs' names must differ."""
 
 from __future__ import annotations
 
@@ -22,9 +23,11 @@ def add_parser(subparsers) -> None:
 
 def run(args) -> int:
     """Load every rig first (so a bad one writes nothing), then write and print each model file."""
-    from ..engines.mjcf import write_model_files
+    from bifilar.rig.hinge import HingeRig
 
-    loaded = [load(path)[0] for path in args.rigs]
+    from ..engines import mjcf, mujoco_hinge
+
+    loaded = [load(path, hinge=True)[0] for path in args.rigs]
     names: dict[str, str] = {}
     for path, rig in zip(args.rigs, loaded):
         if rig.name in names:
@@ -32,6 +35,10 @@ def run(args) -> int:
                            f"goes to {args.out}/<name>/, so the names must differ")
         names[rig.name] = path
     for rig in loaded:
-        for written in write_model_files(rig, Path(args.out) / rig.name):
+        if isinstance(rig, HingeRig):
+            mujoco_hinge.build_spec(rig)  # an unknown moment or stiffness is refused before anything is written
+    for rig in loaded:
+        write = mujoco_hinge.write_model_files if isinstance(rig, HingeRig) else mjcf.write_model_files
+        for written in write(rig, Path(args.out) / rig.name):
             print(written)
     return OK

@@ -1,4 +1,5 @@
-"""What several subcommands share: the rig argument and its loading (``modes``, ``simulate``, ``mjcf``),
+"""What several subcommands share: the rig argument and its loading (``modes``, ``simulate``, ``mjcf``, which
+also take hinge rigs),
 and the report options of the suite's commands (``all``, ``case``)."""
 
 from __future__ import annotations
@@ -9,13 +10,18 @@ from pathlib import Path
 RIG_HELP = "rig file (TOML), or the name of a shipped rig, e.g. plate ('python -m validate list --rigs')"
 
 
-def load(path: str):
-    """The rig file and its rest pose, with every wire hanging down from its anchor."""
+def load(path: str, hinge: bool = False):
+    """The rig file and its rest pose, with every wire hanging down from its anchor; with ``hinge`` a
+    hinge rig file (``[pivot]`` or ``[torsion]``) is taken too and gives ``(HingeRig, None)``, else it is
+    refused in one line."""
     from bifilar.rig import load_rig
     from bifilar.rig.file import check_hanging
+    from bifilar.rig.hinge import HingeRig
     from bifilar.rig.statics import rest_pose
 
-    rig = load_rig(path)
+    rig = load_rig(path, hinge=hinge)
+    if isinstance(rig, HingeRig):
+        return rig, None
     rest = rest_pose(rig)
     check_hanging(rig, rest)
     return rig, rest
