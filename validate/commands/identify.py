@@ -19,6 +19,10 @@ propagated (docs/identification.md); without it nothing of the rig is propagated
   rig's amplitude law and its excess learned from the record, swing checked, inverted, halves fitted,
   pooled); each trial is reported, and the pooled period goes through the propagation with the rig's
   sigmas (common to every trial) once.
+* A hinge rig (``[pivot]`` or ``[torsion]``: a compound or torsion pendulum) is identified by
+  :func:`bifilar.identification.hinge_measurement.measure_hinge`: ``--axis`` must be the body axis
+  parallel to the hinge, a timed period is taken to zero amplitude by the exact law, and the records
+  go through the same loop with the rig's own law (docs/identification.md, section 9).
 * ``--tare FIXTURE.toml``: the fixture alone (same body frame as RIG.toml, its own period or
   records); the object's own moment about the axis through its own COM follows by difference and
   the parallel-axis theorem.
