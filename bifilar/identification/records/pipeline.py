@@ -248,8 +248,8 @@ def swing_problem(record: Record, swing: float, law: AmplitudeLaw, options: Reco
     """Step 3: what is wrong with a record whose swing (rad) is past what the rig can do, naming the
     unit that would make it possible (a factor pi / 180 away) or the column and kind."""
     what = "the rate" if record.kind == "rate" else "the angle"
-    past = ("the wires would turn horizontal or cross" if law.kind == "exact" else
-            "the body would rise to the hooks")
+    past = ("the body would go over the top" if law.kind == "exact" and law.rho == 0.0 else  # a compound pendulum
+            "the wires would turn horizontal or cross" if law.kind == "exact" else "the body would rise to the hooks")
     text = (f"{what} implies a swing of {swing:.4g} rad ({swing / _DEGREE:.4g} deg), past the rig's "
             f"{law.limit:.4g} rad where {past}")
     if options.angle_unit == "rad" and swing * _DEGREE <= law.limit:
