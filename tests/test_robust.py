@@ -426,7 +426,7 @@ def test_the_rig_file_doc_states_the_wire_count_the_reader_accepts():
     assert f"2 to {ranges.MAX_WIRES} of them" in doc and f"| 2 .. {ranges.MAX_WIRES} (`MAX_WIRES`)" in doc
 
 
-@pytest.mark.parametrize("verb", ["all", "list", "case", "modes", "simulate", "mjcf", "identify", "boat", "sweep",
+@pytest.mark.parametrize("verb", ["all", "list", "case", "modes", "simulate", "mjcf", "identify", "calibrate", "boat", "sweep",
                                   "tensor", "plan"])
 def test_every_verbs_help_lists_exactly_its_exit_statuses(verb, capsys, monkeypatch):
     """One source (validate/statuses.py): each verb's --help lists the statuses it can return, no

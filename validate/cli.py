@@ -18,7 +18,7 @@ from bifilar.rig import RigError
 
 from .argtypes import OneLineParser, UsageError
 from .commands import all as all_cmd
-from .commands import boat, case, identify, mjcf, modes, plan, simulate, sweep, tensor
+from .commands import boat, calibrate, case, identify, mjcf, modes, plan, simulate, sweep, tensor
 from .commands import list as list_cmd
 from .statuses import BAD_INPUT, BROKEN_PIPE, INTERRUPTED, RUN_FAILED, RunFailed, epilog
 from .stdout import StdoutFailed
@@ -33,7 +33,7 @@ EPILOG = epilog(examples=(
 
 # Each command's module, in the order of the help: add_parser(subparsers) registers it, run(args) runs it.
 _COMMANDS = {"all": all_cmd, "list": list_cmd, "case": case, "modes": modes, "simulate": simulate, "mjcf": mjcf,
-             "identify": identify, "boat": boat, "tensor": tensor, "plan": plan, "sweep": sweep}
+             "identify": identify, "calibrate": calibrate, "boat": boat, "tensor": tensor, "plan": plan, "sweep": sweep}
 
 
 def build_parser() -> argparse.ArgumentParser:

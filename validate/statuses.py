@@ -39,6 +39,7 @@ COMMANDS: dict[str, dict[int, str]] = {
     "simulate": {**dict.fromkeys(_EVERY, ""), WENT_SLACK: ""},
     "mjcf": dict.fromkeys(_EVERY, ""),
     "identify": dict.fromkeys(_EVERY, ""),
+    "calibrate": dict.fromkeys(_EVERY, ""),
     "boat": dict.fromkeys(_EVERY, ""),
     "tensor": dict.fromkeys(_EVERY, ""),
     "plan": dict.fromkeys(_EVERY, ""),

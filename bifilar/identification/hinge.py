@@ -38,7 +38,8 @@ from bifilar.motion.hinge import period_ratio
 from bifilar.rig.checks import RigError, positive
 from bifilar.rig.hinge import HingeRig
 
-__all__ = ["HingeMoment", "HingeStiffness", "law_for_hinge", "moment_from_period", "stiffness_from_period"]
+__all__ = ["HingeMoment", "HingeStiffness", "law_for_hinge", "moment_from_period", "propagate",
+           "stiffness_from_period"]
 
 _GROUPS = ("mass", "com", "point", "stiffness", "period")
 
@@ -56,7 +57,7 @@ class HingeMoment:
 
     ``gradient``: the partial derivatives of the moment by each input group (module docstring; ``com``
     and ``point`` as body-frame 3-vectors, kg m; the others scalars); ``budget``: group -> share of the
-    variance."""
+    variance; ``sensitivity``: d ln T / d ln J, J / (2 J_p) for a pivot (J_p = J + m d^2), 1/2 for a rod."""
 
     rig: str
     kind: str
@@ -67,11 +68,12 @@ class HingeMoment:
     period0: float  # s, at zero amplitude
     gradient: dict
     budget: dict
+    sensitivity: float = 0.5
 
     def as_dict(self) -> dict:
         return {"rig": self.rig, "kind": self.kind, "moment": self.moment, "std": self.std, "period": self.period,
                 "amplitude": self.amplitude, "period0": self.period0, "gradient": _plain(self.gradient),
-                "budget": dict(self.budget)}
+                "budget": dict(self.budget), "sensitivity": self.sensitivity}
 
 
 @dataclass(frozen=True)
@@ -106,6 +108,11 @@ def moment_from_period(rig: HingeRig, period: float, amplitude: float = 0.0) -> 
         m, d = rig.mass, rig.arm
         c = rig.gravity * t0**2 / four_pi2
         moment = m * c * d - m * d**2
+        if not moment > 0.0:
+            shortest = 2.0 * math.pi * math.sqrt(d / rig.gravity) * ratio
+            raise RigError(rig.source, "period", f"{period:.9g} s is not longer than {shortest:.9g} s, the period of "
+                           f"a point mass {d:.6g} m below the pivot at this amplitude: no body gives it")
+        sensitivity = moment / (2.0 * (moment + m * d**2))
         r = rig.com - rig.point
         n = (r - (r @ rig.axis) * rig.axis) / d
         by_d = m * c - 2.0 * m * d
@@ -119,8 +126,10 @@ def moment_from_period(rig: HingeRig, period: float, amplitude: float = 0.0) -> 
         moment = k * t0**2 / four_pi2
         gradient = {"mass": 0.0, "com": zero, "point": zero, "stiffness": t0**2 / four_pi2,
                     "period": 2.0 * k * t0 / four_pi2 / ratio}
-    std, budget = _propagate(rig, gradient)
-    return HingeMoment(rig.name, rig.kind, float(moment), std, period, float(amplitude), t0, gradient, budget)
+        sensitivity = 0.5
+    std, budget = propagate(rig, gradient)
+    return HingeMoment(rig.name, rig.kind, float(moment), std, period, float(amplitude), t0, gradient, budget,
+                       float(sensitivity))
 
 
 def stiffness_from_period(rig: HingeRig, period: float, amplitude: float = 0.0) -> HingeStiffness:
@@ -139,11 +148,11 @@ def stiffness_from_period(rig: HingeRig, period: float, amplitude: float = 0.0) 
     k = 4.0 * math.pi**2 * moment / t0**2
     zero = np.zeros(3)
     gradient = {"mass": k / rig.mass, "com": zero, "point": zero, "stiffness": 0.0, "period": -2.0 * k / t0 / ratio}
-    std, budget = _propagate(rig, gradient)
+    std, budget = propagate(rig, gradient)
     return HingeStiffness(rig.name, float(k), std, moment, period, float(amplitude), t0, gradient, budget)
 
 
-def _propagate(rig: HingeRig, gradient: dict) -> tuple[float, dict]:
+def propagate(rig: HingeRig, gradient: dict) -> tuple[float, dict]:
     """The standard deviation and the variance budget (group -> share) of ``gradient`` times the rig's
     sigmas, each coordinate of a vector group independent with the group's sigma."""
     parts = {g: float(np.sum(np.square(gradient[g]))) * getattr(rig.uncertainty, g) ** 2 for g in _GROUPS}

@@ -230,10 +230,7 @@ def measure(rig: Rig, axis: str, *, period: float | None = None, amplitude: floa
         trials, ratio = tuple(found_trials), 1.0
         small, small_std = pooled.period, pooled.period_std
         std_source = "the records' fits"
-        flags.extend(said_once([said for tr in trials for said in tr.said]))
-        if not pooled.consistent:
-            flags.append(f"the {len(trials)} trials scatter more than their stated sigmas (chi^2 per degree of "
-                         f"freedom {pooled.chi2_per_dof:.3g}): the pooled sigma is scaled by its square root")
+        flags.extend(record_flags(trials, pooled))
     result = _propagate(rig, axis, small, small_std, samples, flags, p, added)
     result = replace(result, period_std_source=std_source,
                      start_value="nan in the rig file" if was_nan else "the rig file's value (a start only)",
@@ -327,6 +324,16 @@ def subtract_tare(whole: Measurement, fixture: Measurement) -> Measurement:
     part = ObjectMoment(m_obj, tuple(c_obj.tolist()), own, std, own / m_obj,
                         () if own > 0 else ("the object's moment is not positive",))
     return replace(whole, tare=fixture, object_part=part)
+
+
+def record_flags(trials: Sequence[Trial], pooled: Pooled) -> list[str]:
+    """The flags of records pooled: each trial's (:func:`said_once`), and the pool's scatter where it is
+    more than the trials' stated sigmas allow."""
+    flags = said_once([said for tr in trials for said in tr.said])
+    if not pooled.consistent:
+        flags.append(f"the {len(trials)} trials scatter more than their stated sigmas (chi^2 per degree of "
+                     f"freedom {pooled.chi2_per_dof:.3g}): the pooled sigma is scaled by its square root")
+    return flags
 
 
 def said_once(said: Sequence[tuple[str, str]]) -> list[str]:

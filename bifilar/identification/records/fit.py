@@ -191,7 +191,7 @@ def fit_oscillation(t, y, kind: str, law: AmplitudeLaw = LINEAR, *, excess_prior
     model.fit(cyc, slips=True)
     model.check_law(cyc)
     whole = fit_whole(rec, cyc, model, baseline, second)
-    return _result(rec, t, cyc, model, baseline, whole, rejected)
+    return _result(rec, t, cyc, model, baseline, whole, rejected, law.kind)
 
 
 class SwingError(ValueError):
@@ -217,7 +217,7 @@ def _check_swing(cyc: Cycles, law: AmplitudeLaw, kind: str) -> None:
 
 
 def _result(rec: Samples, t: np.ndarray, cyc: Cycles, model: Model, baseline: np.ndarray, whole: Whole,
-            rejected: Rejected) -> OscillationFit:
+            rejected: Rejected, ideal_kind: str = "linear") -> OscillationFit:
     good = cyc.good & np.isfinite(cyc.phase)
     omega0 = whole.omega0
     period = 2.0 * math.pi / omega0
@@ -295,10 +295,10 @@ def _result(rec: Samples, t: np.ndarray, cyc: Cycles, model: Model, baseline: np
         prior_sd = model.prior * abs(model.ideal)
         learned = max(0.0, 1.0 - std[i] ** 2 / prior_sd**2) if prior_sd > 0 else 0.0
     note = ""
-    if model.kind == "proportional" and "kappa" not in names:
+    if model.kind == "proportional" and "kappa" not in names and ideal_kind != "linear":  # linear: no law to apply
         note = ("scale unknown: the ideal law cannot be applied; T0 is the period at the record's amplitudes "
                 "(a small swing assumed)")
-    law = Law(model.law.kind if model.law.kind != "linear" or model.kind != "proportional" else "none (scale unknown)",
+    law = Law("none (scale unknown)" if note else model.law.kind,
               model.ideal, float(excess), float(std[names.index("ds")]) if "ds" in names else 0.0,
               float(quartic), float(std[names.index("dq")]) if "dq" in names else 0.0, float(learned), note,
               model.conflict if model.conflict > LAW_CONFLICT else None)

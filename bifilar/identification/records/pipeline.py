@@ -19,11 +19,17 @@
 
 A trial's repeatability sigma is its period's alone; the rig's geometry and mass are common to every
 trial and enter once, after pooling (:mod:`bifilar.identification.propagation`).
+
+Steps 2 and 4-5 are the rig's: a :class:`Target` says which law a record is fitted with and how a period
+becomes the quantity identified. A wire rig's is built here (:func:`wire_target`); a hinge rig passes its
+own (:func:`bifilar.identification.hinge_measurement.hinge_target`), so that compound and torsion
+pendulums share every other step of this loop.
 """
 
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -91,8 +97,9 @@ class Halves:
 @dataclass(frozen=True)
 class Trial:
     """One record: its fit, its halves (None where a half is too short to fit), the moment it gives
-    (kg m^2) and that moment's repeatability sigma (from the period's sigma alone), the sensitivity
-    d ln T / d ln J, and what it flags."""
+    (kg m^2; a calibration rod's stiffness, N m/rad, where its :class:`Target` identifies that) and its
+    repeatability sigma (from the period's sigma alone), the sensitivity d ln T / d ln J, and what it
+    flags."""
 
     record: Record
     fit: OscillationFit
@@ -122,14 +129,48 @@ class Pooled:
     consistent: bool
 
 
-def identify_records(rig: Rig, axis, paths: list, options: RecordOptions = RecordOptions(),
-                     p: Pencil | None = None) -> tuple[list[Trial], Pooled]:
+@dataclass(frozen=True)
+class Inverted:
+    """A period inverted: the quantity identified (a moment, kg m^2; a rod's stiffness, N m/rad) and
+    d ln T / d ln(quantity) (its sign kept)."""
+
+    value: float
+    sensitivity: float
+
+
+@dataclass(frozen=True)
+class Target:
+    """What a rig does with a record: ``ideal``, the law it is fitted with first; ``law_at(fit)``, the
+    law to refit with once a fit is known (``ideal`` where it does not depend on the moment);
+    ``invert(period)``, the zero-amplitude period (s) as :class:`Inverted`, raising :class:`RigError` on
+    field ``period`` for a period no rig of this kind gives."""
+
+    ideal: AmplitudeLaw
+    law_at: Callable[[OscillationFit], AmplitudeLaw]
+    invert: Callable[[float], Inverted]
+
+
+def wire_target(rig: Rig, axis, p: Pencil) -> Target:
+    """A wire rig's :class:`Target` about ``axis``: :func:`law_for`, recomputed at the identified moment
+    (step 4), and :func:`bifilar.identification.identify.invert_period`; ``p``: its pencil."""
+    ideal = law_for(rig, axis, rest=p.lin.rest)
+
+    def invert(period: float) -> Inverted:
+        found = invert_period(rig, axis, period, p=p)
+        return Inverted(found.moment, found.sensitivity)
+
+    return Target(ideal, lambda fit: _law_at(rig, axis, fit, ideal, p), invert)
+
+
+def identify_records(rig, axis, paths: list, options: RecordOptions = RecordOptions(),
+                     p: Pencil | None = None, target: Target | None = None) -> tuple[list[Trial], Pooled]:
     """The module's loop over ``paths`` (record files, or :class:`.read.Record` objects already read) of
     one rig: the trials and their pool. ``p``: the rig's pencil about ``axis`` (its rest pose), if
-    known. Raises :class:`RigError` naming the file and column of a record that cannot be used,
+    known; ``target``: the rig's :class:`Target` (None: a wire rig's, :func:`wire_target`). Raises
+    :class:`RigError` naming the file and column of a record that cannot be used,
     :class:`.bounds.WorkSpent` naming the file once ``options.max_seconds`` is spent."""
-    p = pencil(rig, axis) if p is None else p
-    ideal = law_for(rig, axis, rest=p.lin.rest)
+    if target is None:
+        target = wire_target(rig, axis, pencil(rig, axis) if p is None else p)
     deadline = Deadline(options.max_seconds)
     trials = []
     for path in paths:
@@ -137,23 +178,22 @@ def identify_records(rig: Rig, axis, paths: list, options: RecordOptions = Recor
             path, options.column, options.kind, time_column=options.time_column, fps=options.fps,
             time_unit=options.time_unit, angle_unit=options.angle_unit, start=options.start, end=options.end)
         try:
-            trials.append(_trial(rig, axis, record, ideal, options, p, deadline))
+            trials.append(_trial(record, target, options, deadline))
         except WorkSpent as exc:
             raise WorkSpent(f"{record.source}: {record.column}: {exc}") from None
     return trials, pool(trials)
 
 
-def _trial(rig: Rig, axis, record: Record, ideal: AmplitudeLaw, options: RecordOptions, p: Pencil,
-           deadline: Deadline) -> Trial:
+def _trial(record: Record, target: Target, options: RecordOptions, deadline: Deadline) -> Trial:
     """Steps 2-6 of the module docstring for one record."""
-    fit = _fit(record, ideal, options, deadline)
-    law = _law_at(rig, axis, fit, ideal, p)
-    if not law.same_as(ideal):
+    fit = _fit(record, target.ideal, options, deadline)
+    law = target.law_at(fit)
+    if not law.same_as(target.ideal):
         fit = _fit(record, law, options, deadline)
-    found = _invert(rig, axis, fit, record, p)
+    found = _invert(target, fit, record)
     split = halves(record, law, options, deadline)
-    std = found.moment * fit.period_std / fit.period / found.sensitivity
-    return Trial(record, fit, split, found.moment, std, found.sensitivity, tuple(_flags(record, fit, split, options)))
+    std = abs(found.value * fit.period_std / fit.period / found.sensitivity)
+    return Trial(record, fit, split, found.value, std, found.sensitivity, tuple(_flags(record, fit, split, options)))
 
 
 def _fit(record: Record, law: AmplitudeLaw, options: RecordOptions, deadline: Deadline | None = None) -> OscillationFit:
@@ -191,15 +231,15 @@ def _law_at(rig: Rig, axis, fit: OscillationFit, ideal: AmplitudeLaw, p: Pencil)
     amplitude; the exact torsion law needs neither."""
     if ideal.kind != "series":
         return ideal
-    found = _invert(rig, axis, fit, None, p)
+    found = invert_period(rig, axis, fit.period, p=p)
     return law_for(found.rig, axis, fit.amplitude[0] if fit.amplitude else None, p.lin.rest)
 
 
-def _invert(rig: Rig, axis, fit: OscillationFit, record: Record | None, p: Pencil):
+def _invert(target: Target, fit: OscillationFit, record: Record) -> Inverted:
     try:
-        return invert_period(rig, axis, fit.period, p=p)
+        return target.invert(fit.period)
     except RigError as exc:
-        if exc.field != "period" or record is None:
+        if exc.field != "period":
             raise
         raise RigError(record.source, record.column, f"fitted period {exc.problem}") from None
 
@@ -208,8 +248,8 @@ def swing_problem(record: Record, swing: float, law: AmplitudeLaw, options: Reco
     """Step 3: what is wrong with a record whose swing (rad) is past what the rig can do, naming the
     unit that would make it possible (a factor pi / 180 away) or the column and kind."""
     what = "the rate" if record.kind == "rate" else "the angle"
-    past = ("the wires would turn horizontal or cross" if law.kind == "exact" else
-            "the body would rise to the hooks")
+    past = ("the body would go over the top" if law.kind == "exact" and law.rho == 0.0 else  # a compound pendulum
+            "the wires would turn horizontal or cross" if law.kind == "exact" else "the body would rise to the hooks")
     text = (f"{what} implies a swing of {swing:.4g} rad ({swing / _DEGREE:.4g} deg), past the rig's "
             f"{law.limit:.4g} rad where {past}")
     if options.angle_unit == "rad" and swing * _DEGREE <= law.limit:
