@@ -100,7 +100,9 @@ def rough_frequency(rec: Samples) -> float:
     span = rec.tau[-1]
     resolution = 2.0 * math.pi / span
     nyquist = math.pi * (len(x) - 1) / (x[-1] - x[0])
-    grid = np.arange(MIN_CYCLES * resolution, nyquist, 0.5 * resolution)
+    # from one cycle a record below the least it may hold: a decaying swing of barely MIN_CYCLES has a broad
+    # peak that leans below its frequency; a record found to hold fewer is refused by the fit after
+    grid = np.arange((MIN_CYCLES - 1) * resolution, nyquist, 0.5 * resolution)
     if len(grid) < 3:
         raise ValueError(f"the record is too short or too sparse to hold {MIN_CYCLES} cycles")
     power = lombscargle(x, v, grid, floating_mean=True)
