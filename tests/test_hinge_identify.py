@@ -71,11 +71,16 @@ def test_calibrate_gives_the_rods_stiffness_back(amplitude, capsys):
     period = period_at(replace(rod, stiffness=K_ROD), amplitude)
     found = calibrate_rod(rod, period=period, amplitude=amplitude)
     assert found.stiffness == pytest.approx(K_ROD, rel=1e-9)
-    assert found.std == pytest.approx(K_ROD * rod.uncertainty.mass / rod.mass, rel=1e-9)  # the mass's alone
+    # k is proportional to J = m (3 r^2 + L^2) / 12: its relative sigma the mass's, the length's and the radius's
+    r, length = rod.cylinder[:2]
+    unc, shape = rod.uncertainty, 3.0 * r**2 + length**2
+    relative = math.sqrt((unc.mass / rod.mass) ** 2 + (2.0 * length * unc.length / shape) ** 2
+                         + (6.0 * r * unc.radius / shape) ** 2)
+    assert found.std == pytest.approx(K_ROD * relative, rel=1e-9)
     assert main(["calibrate", str(RIGS / "calibration_rod.toml"), "--period", repr(period), "--json"]) == 0
     out = json.loads(capsys.readouterr().out)
     assert out["stiffness"] == pytest.approx(K_ROD, rel=1e-9) and out["stiffness_std"] == pytest.approx(found.std)
-    assert set(out["budget"]) == {"mass", "period"}
+    assert set(out["budget"]) == {"mass", "radius", "length", "period"}
 
 
 def test_a_stiffness_in_the_calibration_file_is_ignored_with_a_note():
@@ -222,3 +227,43 @@ def test_an_angle_in_degrees_is_refused_naming_the_unit(tmp_path, capsys):
     assert main(["identify", "wheel_compound", "--axis", "x", "--signal", str(path)]) == 2
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "would go over the top: are the values in degrees" in err
+
+
+def test_calibration_sigma_carries_the_rods_radius_and_length():
+    """dk/dr (outer and inner radius) and dk/dL of a hollow rod against central differences of the
+    stiffness recomputed from a rig file with the dimension stepped (step 1e-7 m: truncation ~1e-14,
+    rounding ~1e-9 relative), and the sigma their quadrature sum with the mass's and period's."""
+    import tomllib
+
+    from bifilar.identification.hinge import stiffness_from_period
+    from bifilar.rig.hinge import hinge_from_dict
+
+    data = tomllib.loads((RIGS / "calibration_rod.toml").read_text())
+    data["body"]["cylinder"] = {"radius": 0.01, "length": 0.8, "inner_radius": 0.006}
+    data["uncertainty"].update(radius=2e-5, length=1e-3, period=1e-3)
+
+    def stiffness(radius=0.01, length=0.8, inner=0.006):
+        stepped = {**data, "body": {**data["body"], "cylinder": {"radius": radius, "length": length,
+                                                                 "inner_radius": inner}}}
+        return stiffness_from_period(hinge_from_dict(stepped), 1.1)
+
+    found, h = stiffness(), 1e-7
+    numeric = {"radius": [(stiffness(radius=0.01 + h).stiffness - stiffness(radius=0.01 - h).stiffness) / (2 * h),
+                          (stiffness(inner=0.006 + h).stiffness - stiffness(inner=0.006 - h).stiffness) / (2 * h)],
+               "length": (stiffness(length=0.8 + h).stiffness - stiffness(length=0.8 - h).stiffness) / (2 * h)}
+    assert found.gradient["radius"] == pytest.approx(numeric["radius"], rel=1e-6)
+    assert found.gradient["length"] == pytest.approx(numeric["length"], rel=1e-6)
+    unc = found.gradient
+    expected = math.sqrt((unc["mass"] * 0.001) ** 2 + (unc["period"] * 1e-3) ** 2
+                         + sum((g * 2e-5) ** 2 for g in unc["radius"]) + (unc["length"] * 1e-3) ** 2)
+    assert found.std == pytest.approx(expected, rel=1e-12)
+    assert found.budget["length"] > 0.1  # a 1 mm tape on 0.8 m: a real share of the stiffness's variance
+
+
+def test_a_radius_sigma_without_a_cylinder_is_refused_in_one_line(tmp_path, capsys):
+    text = (RIGS / "wheel_torsion.toml").read_text().replace("[uncertainty]", "[uncertainty]\nradius = 0.001")
+    path = tmp_path / "wheel.toml"
+    path.write_text(text)
+    assert main(["modes", str(path)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "uncertainty.radius" in err and "body.cylinder" in err and "\n" not in err

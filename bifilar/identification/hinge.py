@@ -19,7 +19,10 @@ the COM, perpendicular to it (body frame), the partial derivatives are, analytic
   dJ/dT = 2 m g d T0 / (4 pi^2) / R(A);
 * torsion: dJ/dk = T0^2 / (4 pi^2), dJ/dT = 2 k T0 / (4 pi^2) / R(A);
 * calibration: dk/dm = k / m (the rod's moment is its mass times a known squared length: the tensor of
-  the file, or a cylinder's, scales with the mass at fixed shape), dk/dT = -2 k / T0 / R(A).
+  the file, or a cylinder's, scales with the mass at fixed shape), dk/dT = -2 k / T0 / R(A), and for a
+  ``body.cylinder`` (:func:`bifilar.rig.hinge.cylinder_inertia`, its axis body x) dk/dr =
+  (4 pi^2 / T0^2) e^T (dI/dr) e with dI/dr = m r diag(1, 1/2, 1/2), the same for the inner radius, and
+  dk/dL = (4 pi^2 / T0^2) e^T (dI/dL) e with dI/dL = m L diag(0, 1/6, 1/6), e the rod's axis.
 
 var = sum_i (dJ/dx_i sigma_i)^2 over every coordinate of every input; the budget gives each group's share
 of the variance (0 everywhere when no sigma is stated). Gravity, the axis's direction and the other entries
@@ -41,7 +44,7 @@ from bifilar.rig.hinge import HingeRig
 __all__ = ["HingeMoment", "HingeStiffness", "law_for_hinge", "moment_from_period", "propagate",
            "stiffness_from_period"]
 
-_GROUPS = ("mass", "com", "point", "stiffness", "period")
+_GROUPS = ("mass", "com", "point", "stiffness", "period", "radius", "length")
 
 
 def law_for_hinge(rig: HingeRig) -> AmplitudeLaw:
@@ -147,7 +150,8 @@ def stiffness_from_period(rig: HingeRig, period: float, amplitude: float = 0.0) 
     t0 = period / ratio
     k = 4.0 * math.pi**2 * moment / t0**2
     zero = np.zeros(3)
-    gradient = {"mass": k / rig.mass, "com": zero, "point": zero, "stiffness": 0.0, "period": -2.0 * k / t0 / ratio}
+    gradient = {"mass": k / rig.mass, "com": zero, "point": zero, "stiffness": 0.0, "period": -2.0 * k / t0 / ratio,
+                **_shape_gradient(rig, 4.0 * math.pi**2 / t0**2)}
     std, budget = propagate(rig, gradient)
     return HingeStiffness(rig.name, float(k), std, moment, period, float(amplitude), t0, gradient, budget)
 
@@ -155,10 +159,22 @@ def stiffness_from_period(rig: HingeRig, period: float, amplitude: float = 0.0) 
 def propagate(rig: HingeRig, gradient: dict) -> tuple[float, dict]:
     """The standard deviation and the variance budget (group -> share) of ``gradient`` times the rig's
     sigmas, each coordinate of a vector group independent with the group's sigma."""
-    parts = {g: float(np.sum(np.square(gradient[g]))) * getattr(rig.uncertainty, g) ** 2 for g in _GROUPS}
+    parts = {g: float(np.sum(np.square(gradient.get(g, 0.0)))) * getattr(rig.uncertainty, g) ** 2 for g in _GROUPS}
     total = sum(parts.values())
     budget = {g: (v / total if total > 0.0 else 0.0) for g, v in parts.items()}
     return math.sqrt(total), budget
+
+
+def _shape_gradient(rig: HingeRig, per_moment: float) -> dict:
+    """d(quantity)/d(radius: outer, inner) and d/d(length) of a ``body.cylinder`` rig, for a quantity
+    ``per_moment`` times the moment about the rod (module docstring); empty without a cylinder."""
+    if rig.cylinder is None:
+        return {}
+    radius, length, inner = rig.cylinder
+    e2 = rig.axis**2  # e^T diag(a, b, c) e
+    per_r2 = float(e2 @ np.array([1.0, 0.5, 0.5])) * rig.mass * per_moment  # d/dr = this x r
+    return {"radius": np.array([per_r2 * radius, per_r2 * inner]),
+            "length": float(e2 @ np.array([0.0, 1.0, 1.0])) * rig.mass * length / 6.0 * per_moment}
 
 
 def _plain(gradient: dict) -> dict:

@@ -194,7 +194,7 @@ def calibrate_rod(rig: HingeRig, *, period: float | None = None, amplitude: floa
                   signals: Sequence | None = None, options: RecordOptions = RecordOptions()) -> Calibration:
     """The stiffness of ``rig``'s torsion rod from the period of its body of known moment (the file's
     tensor or cylinder), timed (``period`` s at ``amplitude`` rad) or from ``signals`` (pooled trials),
-    with its sigma from the period's and the mass's. A stiffness in the file is not used (it is what is
+    with its sigma from the period's, the mass's and a cylinder's radius and length. A stiffness in the file is not used (it is what is
     measured): a flag compares it with the one found. Raises :class:`RigError` for a pivot rig or a body
     whose moment about the rod is unknown."""
     trials: tuple[Trial, ...] = ()
@@ -215,9 +215,10 @@ def calibrate_rod(rig: HingeRig, *, period: float | None = None, amplitude: floa
         flags.append(f"the rig file's torsion.stiffness {rig.stiffness:.6g} N m/rad is not used (it is what is "
                      f"calibrated); it is {off} off the one found")
     if found.std == 0.0:
-        flags.append("no uncertainty is stated (no [uncertainty].mass or .period): the stiffness has no sigma")
+        flags.append("no uncertainty is stated (no [uncertainty].mass, .radius, .length or .period): the stiffness has "
+                     "no sigma")
     ratio = found.period / found.period0
-    budget = {g: found.budget[g] for g in ("mass", "period")}
+    budget = {g: found.budget[g] for g in (("mass", "radius", "length", "period") if rig.cylinder else ("mass", "period"))}
     return Calibration(rig.name, rig.source, found.stiffness, found.std, found.moment, found.period0,
                        used.uncertainty.period / ratio, source, budget, tuple(flags),
                        amplitude=amplitude if amplitude and signals is None else None,

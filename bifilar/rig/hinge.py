@@ -52,13 +52,16 @@ _AXIS_TOL = 1e-12  # an axis whose other components are below this (relative) is
 class HingeUncertainty:
     """Standard deviations of the measured quantities of a hinge rig; zero where not stated: ``mass``
     (kg), ``com`` and ``point`` (m, of each coordinate, body frame), ``stiffness`` (N m/rad), ``period``
-    (s, of one timed period)."""
+    (s, of one timed period), ``radius`` and ``length`` (m, of a ``body.cylinder``'s radii, each, and
+    length)."""
 
     mass: float = 0.0
     com: float = 0.0
     point: float = 0.0
     stiffness: float = 0.0
     period: float = 0.0
+    radius: float = 0.0
+    length: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -76,6 +79,7 @@ class HingeRig:
     gravity: float = 9.81  # m/s^2, along world -z
     uncertainty: HingeUncertainty = field(default_factory=HingeUncertainty)
     source: str = "<memory>"
+    cylinder: tuple[float, float, float] | None = None  # body.cylinder's radius, length, inner radius (m)
 
     @property
     def arm(self) -> float:
@@ -143,13 +147,13 @@ def hinge_from_dict(data: dict, source: str = "<memory>", default_name: str = "r
     no_unknown(body, _BODY_KEYS, source, "body.")
     mass = positive(required(body, "mass", source, "body."), source, "body.mass")
     com = vector3(body.get("com", [0.0, 0.0, 0.0]), source, "body.com")
-    inertia = _body_inertia(body, mass, axis, source)
+    inertia, cylinder = _body_inertia(body, mass, axis, source)
 
     unc_raw = table(data, "uncertainty", source, mandatory=False)
     no_unknown(unc_raw, _UNCERTAINTY_KEYS, source, "uncertainty.")
     unc = HingeUncertainty(**{k: non_negative(v, source, f"uncertainty.{k}") for k, v in unc_raw.items()})
     rig = HingeRig(name=name, mass=mass, inertia=inertia, kind=kind, axis=axis, point=point, stiffness=stiffness,
-                   com=com, gravity=gravity, uncertainty=unc, source=source)
+                   com=com, gravity=gravity, uncertainty=unc, source=source, cylinder=cylinder)
     _check_ranges(rig)
     return rig
 
@@ -163,9 +167,10 @@ def _unit(value, source: str, name: str) -> np.ndarray:
     return v / norm
 
 
-def _body_inertia(body: dict, mass: float, axis: np.ndarray, source: str) -> np.ndarray:
+def _body_inertia(body: dict, mass: float, axis: np.ndarray,
+                  source: str) -> tuple[np.ndarray, tuple[float, float, float] | None]:
     """``body.inertia`` (the axis's diagonal entry may be nan when the axis is a body axis) or the
-    inertia of ``body.cylinder``."""
+    inertia of ``body.cylinder``, with the cylinder's (radius, length, inner radius) or None."""
     if "cylinder" in body:
         if "inertia" in body:
             raise RigError(source, "body.cylinder", "give inertia or cylinder, not both")
@@ -176,10 +181,10 @@ def _body_inertia(body: dict, mass: float, axis: np.ndarray, source: str) -> np.
         inner = non_negative(shape.get("inner_radius", 0.0), source, "body.cylinder.inner_radius")
         if inner >= radius:
             raise RigError(source, "body.cylinder.inner_radius", f"{inner:g} m is not smaller than radius {radius:g} m")
-        return cylinder_inertia(mass, radius, length, inner)
+        return cylinder_inertia(mass, radius, length, inner), (radius, length, inner)
     main = int(np.argmax(np.abs(axis)))
     free = main if np.all(np.abs(np.delete(axis, main)) <= _AXIS_TOL) else None  # nan only about a body axis
-    return inertia_tensor(required(body, "inertia", source, "body."), source, free)
+    return inertia_tensor(required(body, "inertia", source, "body."), source, free), None
 
 
 def _check_ranges(rig: HingeRig) -> None:
@@ -198,14 +203,16 @@ def _check_ranges(rig: HingeRig) -> None:
         raise RigError(src, "pivot.point", f"the axis passes {rig.arm:.3g} m from the COM (less than {MIN_ARM:g} of "
                        f"the body's size {size:.3g} m): gravity has no arm, the body would not swing")
     unc = rig.uncertainty
+    cylinder = rig.cylinder or (None, None, None)
     scales = {"mass": (rig.mass, "kg"), "com": (size, "m"), "point": (size, "m"),
-              "stiffness": (rig.stiffness, "N m/rad")}
+              "stiffness": (rig.stiffness, "N m/rad"), "radius": (cylinder[0], "m"), "length": (cylinder[1], "m")}
     for name, (scale, unit) in scales.items():
         sigma = getattr(unc, name)
         if not sigma:
             continue
         if scale is None:
-            raise RigError(src, f"uncertainty.{name}", "given, but the rig has no torsion.stiffness")
+            raise RigError(src, f"uncertainty.{name}", "given, but the rig has no "
+                           + ("torsion.stiffness" if name == "stiffness" else "body.cylinder"))
         if name == "point" and rig.point is None:
             raise RigError(src, "uncertainty.point", "given, but a torsion rig has no pivot.point")
         within(sigma, MIN_RELATIVE_SIGMA * scale, MAX_RELATIVE_SIGMA * scale, src, f"uncertainty.{name}", unit,
