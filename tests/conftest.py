@@ -13,14 +13,21 @@ whichever test first loops over them, and their one-line note on stderr would la
 output, failing any test that asserts a one-line error or an empty stderr, depending on the order the
 tests run in. The notes are therefore marked as given for the whole session; tests/test_jit.py checks
 them with a fresh record of its own.
+
+One BLAS thread per test worker, as ``python -m validate`` sets it (``validate/__main__.py``): set here,
+before anything imports numpy, so that pytest's two workers do not each run OpenBLAS's threads on the two
+cores.
 """
 
 import os
 import sys
 from pathlib import Path
 
-import pytest
-from hypothesis import HealthCheck, settings
+for _variable in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
+    os.environ.setdefault(_variable, "1")
+
+import pytest  # noqa: E402
+from hypothesis import HealthCheck, settings  # noqa: E402
 
 sys.path.insert(0, str(Path(__file__).parent))  # helper modules beside the tests (thesis_appendix)
 
