@@ -39,9 +39,14 @@ def add_parser(subparsers) -> None:
 def run(args) -> int:
     """Read, fit, report; returns the exit status (errors raised for cli.main)."""
     from bifilar.identification.hangings import fit_hangings, read_hangings
+    from bifilar.identification.hinge_tensor import fit_hinge_hangings, hinge_file, read_hinge_hangings
 
-    setup = read_hangings(args.hangings)
-    result = fit_hangings(setup, args.hangings)
+    if hinge_file(args.hangings):  # torsion and compound pendulums (section 9)
+        setup = read_hinge_hangings(args.hangings)
+        result = fit_hinge_hangings(setup, args.hangings)
+    else:
+        setup = read_hangings(args.hangings)
+        result = fit_hangings(setup, args.hangings)
     report = build_report(setup, result)
     if args.html:
         from ..report.tensor_page import write_tensor_html
@@ -65,7 +70,7 @@ def build_report(setup, result) -> dict:
     if result.covariance is None:
         flags.append("not every hanging states a period sigma (period_std, [uncertainty].period or records): "
                      "no covariance")
-    dof = len(setup.hangings) - 6
+    dof = len(setup.hangings) - setup.unknowns  # a hinge file may hold entries known
     if result.chi2_per_dof is not None and result.chi2_per_dof > chi2_dist.ppf(_CHI2_LEVEL, dof) / dof:
         flags.append(f"the hangings scatter more than their sigmas (chi^2 per degree of freedom "
                      f"{result.chi2_per_dof:.3g}, above the {_CHI2_LEVEL:.0%} bound {chi2_dist.ppf(_CHI2_LEVEL, dof) / dof:.3g})")
@@ -85,7 +90,20 @@ def build_report(setup, result) -> dict:
         "principal": {"moments": moments.tolist(), "moments_std": _matrix(moments_std), "axes": axes.tolist()},
         "object": {"mass": setup.mass, "com": _matrix(setup.com)},
         "hangings": hangings, "tares": tares, "chi2_per_dof": result.chi2_per_dof, "flags": flags,
+        **_hinge_part(setup),
     }
+
+
+def _hinge_part(setup) -> dict:
+    """A hinge hangings file's extra keys: ``rod`` (``stiffness``, ``stiffness_std``, ``source``: the one
+    stiffness every torsion hanging shares) and ``known`` (component -> value held); none for wires."""
+    from bifilar.identification.hinge_tensor import HingeSetup
+
+    if not isinstance(setup, HingeSetup):
+        return {}
+    rod = None if setup.rod is None else {"stiffness": setup.rod.stiffness, "stiffness_std": setup.rod.std,
+                                          "source": setup.rod.source}
+    return {"rod": rod, "known": {COMPONENTS[i]: v for i, v in sorted(setup.known.items())}}
 
 
 def _pm(value: float, std) -> str:
@@ -111,6 +129,12 @@ def text(report: dict) -> str:
     for k, f in enumerate(report["tares"]):
         lines.append(f"tare {k}: {f['rig']}: {_pm(f['moment'], f['moment_std'])} kg m^2 about its vertical, "
                      f"from {f['period']:.9g} s, held in {len(f['hangings'])} hanging(s)")
+    if report.get("rod"):
+        r = report["rod"]
+        lines.append(f"rod: {_pm(r['stiffness'], r['stiffness_std'])} N m/rad ({r['source']}), one error shared by "
+                     "every torsion hanging")
+    if report.get("known"):
+        lines.append("held known: " + ", ".join(f"{c} = {v:.7g}" for c, v in report["known"].items()))
     if report["chi2_per_dof"] is not None:
         lines.append(f"chi^2 per degree of freedom: {report['chi2_per_dof']:.3g}")
     lines += [f"flag: {f}" for f in report["flags"]]
