@@ -200,3 +200,14 @@ def test_cli_on_the_shipped_example():
     assert np.all(np.abs(t - truth) < 1e-6 + 3 * s)  # periods given to 1e-5 s: within their sigmas
     text = subprocess.run(run, capture_output=True, text=True, cwd=ROOT, check=True).stdout
     assert "rod: " in text and "principal 1" in text
+
+
+def test_a_wire_rig_among_hinge_rigs_refused(tmp_path):
+    """One hangings file takes wire rigs or hinge rigs: a wire rig among hinge rigs is named, one line."""
+    path = _write(tmp_path, "[rod]\nstiffness = 5.0\nstiffness_std = 0.05\n")
+    wire = ROOT / "models" / "rigs" / "plate.toml"
+    path.write_text(path.read_text() + f'[[hanging]]\nrig = "{wire}"\nperiod = 1.0\n')
+    with pytest.raises(RigError) as refused:
+        read_hinge_hangings(path)
+    text = str(refused.value)
+    assert "hanging[8].rig" in text and "not a hinge rig" in text and "\n" not in text

@@ -221,15 +221,15 @@ class HingeSetup:
 
 
 def hinge_file(path: str | Path) -> bool:
-    """Whether the hangings file's first hanging's rig is a hinge rig (``[pivot]`` or ``[torsion]``):
-    such a file is read by :func:`read_hinge_hangings`. A file whose first rig cannot be read says so
-    when read as a wire hangings file."""
+    """Whether any hanging's rig in the hangings file is a hinge rig (``[pivot]`` or ``[torsion]``): such a
+    file is read by :func:`read_hinge_hangings`, which refuses a wire rig among them. A file or rig that
+    cannot be read says so when read as a wire hangings file."""
     data = read_toml(path)
     raw = data.get("hanging")
-    if not isinstance(raw, list) or not raw or not isinstance(raw[0], dict) or not isinstance(raw[0].get("rig"), str):
+    if not isinstance(raw, list):
         return False
-    rig = Path(path).parent / raw[0]["rig"]
-    return rig.is_file() and any(t in read_toml(rig) for t in HINGE_TABLES)
+    rigs = [Path(path).parent / h["rig"] for h in raw if isinstance(h, dict) and isinstance(h.get("rig"), str)]
+    return any(r.is_file() and any(t in read_toml(r) for t in HINGE_TABLES) for r in rigs)
 
 
 def read_hinge_hangings(path: str | Path) -> HingeSetup:

@@ -4,6 +4,9 @@
 
 The hangings file (docs/identification.md, section 8) lists ``[[hanging]]`` tables: the rig as hung,
 the object's orientation in it, and a period (s) or records; optionally a tare (the fixture alone).
+A file whose rigs are hinge rigs (a torsion rod, a compound pendulum; section 9) is read and fitted by
+:mod:`bifilar.identification.hinge_tensor` (linear in the six components, the rod's stiffness one
+error shared by every torsion hanging) and reported the same way, with ``rod`` and ``known`` added.
 :mod:`bifilar.identification.hangings` reads and measures them, :mod:`bifilar.identification.tensor`
 fits the six components on the exact linearisation. The tensor is about the object's COM in the
 object's axes (kg m^2); its covariance is over I_xx, I_yy, I_zz, I_xy, I_yz, I_xz.
