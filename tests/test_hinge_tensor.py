@@ -211,3 +211,30 @@ def test_a_wire_rig_among_hinge_rigs_refused(tmp_path):
         read_hinge_hangings(path)
     text = str(refused.value)
     assert "hanging[8].rig" in text and "not a hinge rig" in text and "\n" not in text
+
+
+def test_plan_on_a_torsion_rod_predicts_the_fit_covariance():
+    """``validate plan`` on a torsion rod: six orientations chosen from 200 have a worst sigma no larger
+    than the textbook six's, and their predicted covariance is the fit's (stiffness exact) to 1e-6."""
+    from bifilar.identification import plan as planning
+    from bifilar.identification.hinge_tensor import hinge_candidates
+
+    rig = HingeRig("rod", MASS, X, "torsion", Z, stiffness=K, com=COM)
+    pool, _ = hinge_candidates(rig, X, 2e-4, planning.hemisphere(200))
+    book, _ = hinge_candidates(rig, X, 2e-4, planning.TEXTBOOK)
+    scale = float(np.linalg.eigvalsh(X).max())
+    best = planning.plan(pool, 6, "worst", scale, starts=(book,))
+    assert best.worst <= planning.design(book, scale).worst
+    hangings = [torsion(c.orientation, period_std=2e-4) for c in best.chosen]
+    fitted = identify_hinge_tensor(hangings, Rod(K, 0.0, "t")).covariance
+    assert np.abs(fitted - best.covariance).max() < 1e-6 * np.abs(best.covariance).max()
+
+
+def test_plan_refuses_a_compound_pendulum(tmp_path):
+    (tmp_path / "knife.toml").write_text(
+        f'[body]\nmass = {MASS}\ncom = [0.0, 0.0, 0.0]\ninertia = [0.2, 0.2, 0.05]\n'
+        '[pivot]\npoint = [0.0, 0.0, 0.3]\naxis = [1.0, 0.0, 0.0]\n[uncertainty]\nperiod = 2e-4\n')
+    (tmp_path / "c.toml").write_text('rig = "knife.toml"\ngenerate = 20\n')
+    out = subprocess.run([sys.executable, "-m", "validate", "plan", str(tmp_path / "c.toml"), "--count", "6"],
+                         capture_output=True, text=True, cwd=ROOT)
+    assert out.returncode == 2 and "compound pendulum" in out.stderr and len(out.stderr.strip().splitlines()) == 1

@@ -43,7 +43,7 @@ from pathlib import Path
 import numpy as np
 from scipy.linalg import solve_triangular
 
-from bifilar.motion.hinge import period_ratio
+from bifilar.motion.hinge import linear_period, moment_about_axis, period_ratio
 from bifilar.rig import RigError
 from bifilar.rig.checks import no_unknown, number, positive, read_toml, required, within
 from bifilar.rig.hinge import HINGE_TABLES, HingeRig, hinge_from_dict
@@ -51,10 +51,11 @@ from bifilar.rig.ranges import RANGES
 
 from .hangings import PERIOD_RANGE, Measured, orientation, period_sigma
 from .hinge import moment_from_period, stiffness_from_period
+from .plan import Candidate
 from .tensor import COMPONENTS, Tensor, tensor_of
 
-__all__ = ["HingeHanging", "HingeSetup", "Rod", "fit_hinge_hangings", "hinge_file", "identify_hinge_tensor",
-           "read_hinge_hangings", "row"]
+__all__ = ["HingeHanging", "HingeSetup", "Rod", "fit_hinge_hangings", "hinge_candidates", "hinge_file",
+           "identify_hinge_tensor", "read_hinge_hangings", "row"]
 
 _KEYS = {"hanging", "name", "rod", "known"}
 _HANGING_KEYS = {"rig", "orientation", "period", "period_std", "amplitude", "name"}
@@ -145,6 +146,20 @@ def identify_hinge_tensor(hangings: list[HingeHanging], rod: Rod | None = None, 
         chi2 = float(white @ white) / dof
     spread = np.sqrt(np.diag(cov))
     return Tensor(inertia, covariance, model, resid / spread if np.all(spread > 0.0) else None, chi2)
+
+
+def hinge_candidates(rig: HingeRig, inertia: np.ndarray, sigma: float, orientations):
+    """(candidates, names skipped with the reason: none) for ``validate plan`` on a torsion rod: the part
+    (``rig``'s [body] in object axes, expected tensor ``inertia``) turned by each Q, its period
+    T = 2 pi sqrt(J / k) and d T / d x = T a / (2 J) (a the hanging's :func:`row`, J = a . x), for
+    :func:`bifilar.identification.plan.plan`. The rod's stiffness error scales every moment alike whatever
+    the orientations: no plan lowers it, so the plan weighs the periods' sigma alone."""
+    usable = []
+    for name, q in orientations:
+        turned = replace(rig, com=q @ rig.com, inertia=q @ inertia @ q.T)
+        t = linear_period(turned)
+        usable.append(Candidate(name, q, t * row(rig.axis, q) / (2.0 * moment_about_axis(turned)), t, sigma))
+    return usable, []
 
 
 def _check_rank(a: np.ndarray, free: list[int], n: int, source: str) -> None:
