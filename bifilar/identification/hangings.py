@@ -92,6 +92,11 @@ class Setup:
     com: np.ndarray | None  # object axes (without a tare), else None
     flags: list[str] = field(default_factory=list)
 
+    @property
+    def unknowns(self) -> int:
+        """The components fitted: all six (a hinge hangings file may hold some known)."""
+        return 6
+
 
 def read_hangings(path: str | Path) -> Setup:
     """Read the hangings file, measure every period (records fitted, tares identified) and build the

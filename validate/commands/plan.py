@@ -5,7 +5,9 @@
 The candidates file (docs/identification.md, section 8):
 
 * ``rig`` (path relative to the file): the rig, its ``[body]`` the object in its own axes (mass, com,
-  and the expected ``inertia``: a finite tensor, the plan's linearisation point);
+  and the expected ``inertia``: a finite tensor, the plan's linearisation point); a wire rig or a
+  torsion rod (``[torsion]`` with its ``stiffness``: each candidate turns the part about the rod,
+  :func:`bifilar.identification.hinge_tensor.hinge_candidates`);
 * ``fixture`` (optional): a platform the object is mounted on, its COM on the fixture's COM;
 * ``period_std`` (s; default the rig's ``[uncertainty].period``): every period's sigma;
 * ``generate = N`` (optional, 1 .. 5000, seconds): N orientations with vertical object axes spread over a hemisphere;
@@ -53,11 +55,17 @@ def add_parser(subparsers) -> None:
 
 def run(args) -> int:
     from bifilar.identification import plan as planning
+    from bifilar.identification.hinge_tensor import hinge_candidates
     from bifilar.rig import RigError
+    from bifilar.rig.hinge import HingeRig
 
     rig, fixture, sigma, orientations = read_candidates(args.candidates)
-    pool, skipped = planning.candidates(rig, rig.inertia, sigma, orientations, fixture)
-    book, book_skipped = planning.candidates(rig, rig.inertia, sigma, planning.TEXTBOOK, fixture)
+    if isinstance(rig, HingeRig):  # a torsion rod or a knife edge: the period's moment is linear in the tensor
+        pool, skipped = hinge_candidates(rig, rig.inertia, sigma, orientations)
+        book, book_skipped = hinge_candidates(rig, rig.inertia, sigma, planning.TEXTBOOK)
+    else:
+        pool, skipped = planning.candidates(rig, rig.inertia, sigma, orientations, fixture)
+        book, book_skipped = planning.candidates(rig, rig.inertia, sigma, planning.TEXTBOOK, fixture)
     scale = float(np.linalg.eigvalsh(rig.inertia).max())
     if len(pool) < args.count:
         raise RigError(args.candidates, "candidate", f"{len(pool)} usable candidates for --count {args.count}"
@@ -85,6 +93,7 @@ def read_candidates(path: str):
     from bifilar.identification.plan import hemisphere
     from bifilar.rig import RigError, load_rig
     from bifilar.rig.checks import no_unknown, read_toml, required
+    from bifilar.rig.hinge import HingeRig
 
     data = read_toml(path)
     folder = Path(path).parent
@@ -92,7 +101,15 @@ def read_candidates(path: str):
     name = required(data, "rig", path, "")
     if not isinstance(name, str):
         raise RigError(path, "rig", "must be a file name (relative to the candidates file)")
-    rig = load_rig(folder / name)
+    rig = load_rig(folder / name, hinge=True)
+    if isinstance(rig, HingeRig):
+        if rig.kind != "torsion":
+            raise RigError(path, "rig", f"{rig.source} is a compound pendulum: the plan proposes orientations on a "
+                           "torsion rod (or wires); a knife edge supplies one moment, chosen by hand")
+        if "fixture" in data:
+            raise RigError(path, "fixture", "a part on a torsion rod is clamped alone: no fixture")
+        if not np.isfinite(rig.inertia).all():
+            raise RigError(str(rig.source), "body.inertia", "the plan needs the expected tensor (finite): nan given")
     fixture = None
     if "fixture" in data:
         if not isinstance(data["fixture"], str):

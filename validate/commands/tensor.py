@@ -4,6 +4,9 @@
 
 The hangings file (docs/identification.md, section 8) lists ``[[hanging]]`` tables: the rig as hung,
 the object's orientation in it, and a period (s) or records; optionally a tare (the fixture alone).
+A file whose rigs are hinge rigs (a torsion rod, a compound pendulum; section 9) is read and fitted by
+:mod:`bifilar.identification.hinge_tensor` (linear in the six components, the rod's stiffness one
+error shared by every torsion hanging) and reported the same way, with ``rod`` and ``known`` added.
 :mod:`bifilar.identification.hangings` reads and measures them, :mod:`bifilar.identification.tensor`
 fits the six components on the exact linearisation. The tensor is about the object's COM in the
 object's axes (kg m^2); its covariance is over I_xx, I_yy, I_zz, I_xy, I_yz, I_xz.
@@ -39,9 +42,14 @@ def add_parser(subparsers) -> None:
 def run(args) -> int:
     """Read, fit, report; returns the exit status (errors raised for cli.main)."""
     from bifilar.identification.hangings import fit_hangings, read_hangings
+    from bifilar.identification.hinge_tensor import fit_hinge_hangings, hinge_file, read_hinge_hangings
 
-    setup = read_hangings(args.hangings)
-    result = fit_hangings(setup, args.hangings)
+    if hinge_file(args.hangings):  # torsion and compound pendulums (section 9)
+        setup = read_hinge_hangings(args.hangings)
+        result = fit_hinge_hangings(setup, args.hangings)
+    else:
+        setup = read_hangings(args.hangings)
+        result = fit_hangings(setup, args.hangings)
     report = build_report(setup, result)
     if args.html:
         from ..report.tensor_page import write_tensor_html
@@ -65,7 +73,7 @@ def build_report(setup, result) -> dict:
     if result.covariance is None:
         flags.append("not every hanging states a period sigma (period_std, [uncertainty].period or records): "
                      "no covariance")
-    dof = len(setup.hangings) - 6
+    dof = len(setup.hangings) - setup.unknowns  # a hinge file may hold entries known
     if result.chi2_per_dof is not None and result.chi2_per_dof > chi2_dist.ppf(_CHI2_LEVEL, dof) / dof:
         flags.append(f"the hangings scatter more than their sigmas (chi^2 per degree of freedom "
                      f"{result.chi2_per_dof:.3g}, above the {_CHI2_LEVEL:.0%} bound {chi2_dist.ppf(_CHI2_LEVEL, dof) / dof:.3g})")
@@ -85,7 +93,20 @@ def build_report(setup, result) -> dict:
         "principal": {"moments": moments.tolist(), "moments_std": _matrix(moments_std), "axes": axes.tolist()},
         "object": {"mass": setup.mass, "com": _matrix(setup.com)},
         "hangings": hangings, "tares": tares, "chi2_per_dof": result.chi2_per_dof, "flags": flags,
+        **_hinge_part(setup),
     }
+
+
+def _hinge_part(setup) -> dict:
+    """A hinge hangings file's extra keys: ``rod`` (``stiffness``, ``stiffness_std``, ``source``: the one
+    stiffness every torsion hanging shares) and ``known`` (component -> value held); none for wires."""
+    from bifilar.identification.hinge_tensor import HingeSetup
+
+    if not isinstance(setup, HingeSetup):
+        return {}
+    rod = None if setup.rod is None else {"stiffness": setup.rod.stiffness, "stiffness_std": setup.rod.std,
+                                          "source": setup.rod.source}
+    return {"rod": rod, "known": {COMPONENTS[i]: v for i, v in sorted(setup.known.items())}}
 
 
 def _pm(value: float, std) -> str:
@@ -111,6 +132,12 @@ def text(report: dict) -> str:
     for k, f in enumerate(report["tares"]):
         lines.append(f"tare {k}: {f['rig']}: {_pm(f['moment'], f['moment_std'])} kg m^2 about its vertical, "
                      f"from {f['period']:.9g} s, held in {len(f['hangings'])} hanging(s)")
+    if report.get("rod"):
+        r = report["rod"]
+        lines.append(f"rod: {_pm(r['stiffness'], r['stiffness_std'])} N m/rad ({r['source']}), one error shared by "
+                     "every torsion hanging")
+    if report.get("known"):
+        lines.append("held known: " + ", ".join(f"{c} = {v:.7g}" for c, v in report["known"].items()))
     if report["chi2_per_dof"] is not None:
         lines.append(f"chi^2 per degree of freedom: {report['chi2_per_dof']:.3g}")
     lines += [f"flag: {f}" for f in report["flags"]]
