@@ -6,6 +6,8 @@
   builds the moment about the axis from the full tensor and the pivot's offset itself.
 * The torsion pendulum's 2 pi sqrt(J / k) against MuJoCo's hinge spring, at two steps: the measured period
   error must be RK4's own (omega h)^4 / 120, so a wrong J or k shows however small.
+* A fork's full tensor (:mod:`bifilar.identification.hinge_tensor`'s linear rows) from MuJoCo's periods of
+  it turned six ways on a torsion rod and swung on a knife edge.
 * The calibration rod's inertia (:func:`bifilar.rig.hinge.cylinder_inertia`) against the volume integral
   of r^2 dm by Gauss-Legendre quadrature (exact for the polynomial integrand), solid and hollow.
 
@@ -21,6 +23,7 @@ from dataclasses import replace
 import numpy as np
 from scipy.integrate import quad
 
+from bifilar.identification.hinge_tensor import Rod, identify_hinge_tensor, read_hinge_hangings
 from bifilar.motion.hinge import linear_period, moment_about_axis, period_at
 from bifilar.rig.file import load_rig
 from bifilar.rig.hinge import HingeRig, cylinder_inertia
@@ -161,3 +164,36 @@ def _volume_integral(mass: float, radius: float, length: float, inner: float) ->
     rr = np.einsum("...i,...j->...ij", r, r)
     tensor = np.tensordot(W, np.einsum("...k,...k->...", r, r)[..., None, None] * np.eye(3) - rr, axes=3)
     return density * tensor
+
+
+# The generated fork of models/hangings/fork_torsion.toml (its header): tensor about the COM, object axes
+FORK = np.array([[0.0912, 0.0031, -0.0204], [0.0031, 0.1106, 0.0057], [-0.0204, 0.0057, 0.0278]])  # kg m^2
+FORK_ROD = 5.0  # N m/rad
+
+
+@case("hinge-tensor-mujoco", source="issue 38 item 4; BicycleParameters' torsion and compound hangings",
+      engines=("mujoco", "analytic"))
+def tensor_mujoco(ctx: CaseContext):
+    """A fork's full tensor from MuJoCo's periods of it on a torsion rod (six orientations) and a knife edge
+    (0.25 rad): the linear rows of bifilar.identification.hinge_tensor against MuJoCo's own composite inertia."""
+    setup = read_hinge_hangings(RIGS.parent / "hangings" / "fork_torsion.toml")
+    hangings, worst = [], 0.0
+    for h in setup.hangings:
+        q = h.orientation
+        truth = replace(h.rig, inertia=q @ FORK @ q.T, stiffness=FORK_ROD if h.rig.kind == "torsion" else None)
+        exact = period_at(truth, h.amplitude)
+        h_step = mujoco_hinge.TIMESTEP
+        dt_out = h_step * max(1, round(exact / SAMPLES / h_step))
+        traj = mujoco_hinge.run(truth, h.amplitude or 0.3, 4.0 * exact, dt_out)
+        measured = _period(traj)
+        if h.rig.kind == "torsion" and not h.amplitude:  # a rod is isochronous: the run's 0.3 rad is any amplitude
+            measured /= 1.0 + (2.0 * math.pi / exact * h_step) ** 4 / 120.0  # RK4's known lengthening taken out
+        worst = max(worst, abs(measured / exact - 1.0))
+        hangings.append(replace(h, period=measured, sigma=0.0))
+    fitted = identify_hinge_tensor(hangings, Rod(FORK_ROD, 0.0, "case")).inertia
+    return [check("MuJoCo periods vs the exact law, worst of seven", worst, 1e-10,
+                  "RK4 at omega h < 2e-3 ((omega h)^4 / 120 < 2e-13) plus the crossing floor 1e-11"),
+            check("tensor from MuJoCo's periods vs the fork's, / largest entry",
+                  float(np.abs(fitted - FORK).max() / np.abs(FORK).max()), 1e-9,
+                  "moments carry 2 x the periods' 1e-11; six rows of condition ~10 and the knife edge's m d^2 "
+                  "(~4x the moment) amplify it to ~1e-10")]
