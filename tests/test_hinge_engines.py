@@ -110,3 +110,22 @@ def test_wire_only_loading_refuses_hinge_rigs():
 
     with pytest.raises(RigError, match="wire rigs only"):
         load(str(RIGS / "wheel_torsion.toml"))
+
+
+def test_simulate_records_a_hinge_rig_for_rerun(known_rig, tmp_path, capsys):
+    """``--rerun`` on a hinge rig: a recording rerun itself verifies, opening on the 3D scene (the pivot
+    axis, the body, its trail) beside the angle and rate plotted."""
+    from rerun.chunk import RrdReader
+
+    from rrd_check import verify, views
+
+    rrd = tmp_path / "swing.rrd"
+    assert main(["simulate", known_rig, "--engine", "kane", "--amplitude", "0.5", "--duration", "2",
+                 "--out", str(tmp_path / "swing.csv"), "--rerun", str(rrd)]) == 0
+    verify(rrd)
+    shown = views(rrd)
+    assert shown["rig"][0] == "3D"
+    assert any(name == "angle" for name in shown)
+    (store,) = RrdReader(rrd).recordings()
+    entities = {chunk.entity_path.lstrip("/") for chunk in RrdReader(rrd).stream(store=store)}
+    assert {"world/wc_known/hinge", "world/wc_known/kane/body", "world/wc_known/kane/trail"} <= entities

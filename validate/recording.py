@@ -10,7 +10,10 @@ case's metrics and verdict are a text document. The default blueprint opens on t
 timeline (or the one :func:`record` is given), with the 3D view, the tensions, the periods, the
 thesis angles and the differences; the other channels are tabs beside the metrics.
 
-Trajectories without a rig (seed pendula) are plotted only. Time-varying data goes through
+A hinge rig's run (a compound or torsion pendulum, ``meta["hinge"]``: :mod:`validate.engines.hinge`) is
+drawn with its axis instead of wires: a compound pendulum's pivot axis along world x through the origin,
+a torsion rod rising from the COM along world z. Trajectories without a rig (seed pendula) are plotted
+only. Time-varying data goes through
 ``send_columns``, one call per entity, so that recording costs little next to simulating
 (``python benchmarks/recording.py``). A file is written under a temporary name and renamed: a
 recording is whole or absent.
@@ -49,6 +52,7 @@ SLACK_RGB = (230, 30, 30)  # tension <= 0 (slack, or an equality cable pushing):
 # Viridis sampled at 0, 1/8, ..., 1: perceptually uniform, so equal colour steps are equal tension steps.
 VIRIDIS = np.array([(68, 1, 84), (71, 44, 122), (59, 81, 139), (44, 113, 142), (33, 144, 141),
                     (39, 173, 129), (92, 200, 99), (170, 220, 50), (253, 231, 37)], dtype=float)
+_BEAM_RGB = (115, 90, 75)  # a hinge's axis or rod, as the MJCF scene's beam
 RUN_RGB = ((31, 119, 180), (255, 127, 14), (44, 160, 44), (148, 103, 189), (140, 86, 75), (227, 119, 194))
 MAIN_PLOTS = ("tension", "period", "theta")  # plotted in full view; every other channel gets a tab
 UNITS = {"com": "m", "tension": "N", "length_error": "m", "velocity": "m/s", "omega": "rad/s",
@@ -69,6 +73,8 @@ class _Run:
 
     @property
     def drawn(self) -> bool:
+        if "hinge" in self.traj.meta:
+            return "com" in self.traj and "quat" in self.traj
         return "rig_spec" in self.traj.meta and all(c in self.traj for c in RIG_CHANNELS)
 
 
@@ -183,38 +189,54 @@ def inertia_box(inertia: np.ndarray, mass: float) -> tuple[np.ndarray, np.ndarra
 
 
 def _log_scene(rec: rr.RecordingStream, runs: list[_Run]) -> None:
-    """Each rig's anchors once, then every run's wires, body and trail; rigs side by side along x."""
+    """Each rig's anchors (or hinge axis) once, then every run's wires, body and trail; rigs side by side
+    along x."""
     if not runs:
         return
     rec.log("world", rr.ViewCoordinates.RIGHT_HAND_Z_UP, static=True)
-    t_max = max(float(np.nanmax(r.traj["tension"], initial=0.0)) for r in runs) or 1.0
+    t_max = max((float(np.nanmax(r.traj["tension"], initial=0.0)) for r in runs if "tension" in r.traj),
+                default=0.0) or 1.0
     x = last_reach = 0.0
     for rig_name, group in by_rig(runs, _rig).items():
-        rig = group[0].traj.meta["rig_spec"]
-        reach = max(abs(w.anchor[0]) for w in rig.wires) + max(w.length for w in rig.wires)  # in x, from x = 0
+        hinge = group[0].traj.meta.get("hinge")
+        if hinge is None:
+            rig = group[0].traj.meta["rig_spec"]
+            reach = max(abs(w.anchor[0]) for w in rig.wires) + max(w.length for w in rig.wires)  # in x, from x = 0
+            scale = max(w.length for w in rig.wires)
+        else:
+            scale = reach = 2.0 * (hinge.size + hinge.arm)
         x += 1.1 * (last_reach + reach) if last_reach else 0.0
         last_reach = reach
         base = f"world/{rig_name}"
         rec.log(base, rr.Transform3D(translation=(x, 0.0, 0.0)), static=True)
-        scale = max(w.length for w in rig.wires)
-        rec.log(f"{base}/anchors", rr.Points3D([w.anchor for w in rig.wires], radii=0.01 * scale,
-                                               labels=[f"anchor {k + 1}" for k in range(len(rig.wires))]), static=True)
+        if hinge is None:
+            rec.log(f"{base}/anchors", rr.Points3D([w.anchor for w in rig.wires], radii=0.01 * scale,
+                                                   labels=[f"anchor {k + 1}" for k in range(len(rig.wires))]),
+                    static=True)
+        else:
+            rec.log(f"{base}/hinge", _hinge_axis(hinge, scale), static=True)
         for run in group:
             _log_run(rec, f"{base}/{run.label}", run, t_max, scale)
 
 
-def _log_run(rec: rr.RecordingStream, base: str, run: _Run, t_max: float, scale: float) -> None:
-    traj, rig = run.traj, run.traj.meta["rig_spec"]
-    n, time = len(traj.t), _time(traj.t)
-    com, tension = np.asarray(traj["com"]), np.asarray(traj["tension"])
-    rot = Rotation.from_quat(traj["quat"], scalar_first=True)
-    ends = np.stack([np.stack([np.broadcast_to(w.anchor, (n, 3)), com + rot.apply(w.attach - rig.com)], axis=1)
-                     for w in rig.wires], axis=1)  # (n, wire, 2, 3)
-    labels = [f"{v:.1f} N" for v in tension.ravel()]
-    rec.send_columns(f"{base}/wires", time, rr.LineStrips3D.columns(
-        strips=ends.reshape(-1, 2, 3), colors=tension_colors(tension, t_max).reshape(-1, 3), labels=labels,
-        radii=np.full(tension.size, 0.004 * scale, dtype=np.float32)).partition([len(rig.wires)] * n))
+def _hinge_axis(rig, scale: float) -> rr.LineStrips3D:
+    """The hinge of :mod:`validate.engines.hinge`'s world: a pivot axis along x through the origin, or a
+    torsion rod from the COM (the origin) up along z, ``scale`` m long."""
+    if rig.kind == "pivot":
+        ends, label = [(-0.5 * scale, 0.0, 0.0), (0.5 * scale, 0.0, 0.0)], "pivot axis"
+    else:
+        ends, label = [(0.0, 0.0, 0.0), (0.0, 0.0, scale)], f"torsion rod, {rig.stiffness:.6g} N m/rad"
+    return rr.LineStrips3D([ends], radii=0.006 * scale, colors=[_BEAM_RGB], labels=[label])
 
+
+def _log_run(rec: rr.RecordingStream, base: str, run: _Run, t_max: float, scale: float) -> None:
+    traj = run.traj
+    rig = traj.meta.get("hinge") or traj.meta["rig_spec"]
+    n, time = len(traj.t), _time(traj.t)
+    com = np.asarray(traj["com"])
+    rot = Rotation.from_quat(traj["quat"], scalar_first=True)
+    if "hinge" not in traj.meta:
+        _log_wires(rec, base, traj, rig, com, rot, t_max, scale)
     rec.send_columns(f"{base}/body", time, rr.Transform3D.columns(translation=com, quaternion=rot.as_quat()))
     half, quat = inertia_box(rig.inertia, rig.mass)
     rec.log(f"{base}/body", rr.TransformAxes3D(1.5 * float(half.max())), static=True)
@@ -225,6 +247,18 @@ def _log_run(rec: rr.RecordingStream, base: str, run: _Run, t_max: float, scale:
     rec.send_columns(f"{base}/trail", time, rr.LineStrips3D.columns(
         strips=segments, colors=np.tile(np.array(run.rgb, dtype=np.uint8), (n, 1)),
         radii=np.full(n, 0.003 * scale, dtype=np.float32)))
+
+
+def _log_wires(rec: rr.RecordingStream, base: str, traj: Trajectory, rig, com: np.ndarray, rot: Rotation,
+               t_max: float, scale: float) -> None:
+    """Each wire from its anchor to its attachment, coloured and labelled by its tension."""
+    n, tension = len(traj.t), np.asarray(traj["tension"])
+    ends = np.stack([np.stack([np.broadcast_to(w.anchor, (n, 3)), com + rot.apply(w.attach - rig.com)], axis=1)
+                     for w in rig.wires], axis=1)  # (n, wire, 2, 3)
+    labels = [f"{v:.1f} N" for v in tension.ravel()]
+    rec.send_columns(f"{base}/wires", _time(traj.t), rr.LineStrips3D.columns(
+        strips=ends.reshape(-1, 2, 3), colors=tension_colors(tension, t_max).reshape(-1, 3), labels=labels,
+        radii=np.full(tension.size, 0.004 * scale, dtype=np.float32)).partition([len(rig.wires)] * n))
 
 
 # ---------------------------------------------------------------------------------------- series

@@ -6,7 +6,8 @@ A taut-wire model stops where a wire goes slack: the CSV ends there and the exit
 A hinge rig (``[pivot]`` or ``[torsion]``) runs on ``kane`` (the exact 1-DOF equation,
 :func:`validate.engines.hinge.run`) or ``mujoco`` (:mod:`validate.engines.mujoco_hinge`) from rest at
 ``--amplitude``; its CSV has the COM and quaternion columns of a wire rig's, then ``angle`` and ``rate``
-(:func:`validate.trajectory.write_hinge_csv`). The wire engines and ``--rerun`` are refused for it.
+(:func:`validate.trajectory.write_hinge_csv`); ``--rerun`` draws its axis, body and trail. The wire engines are
+refused for it.
 """
 
 from __future__ import annotations
@@ -121,8 +122,6 @@ def _run_hinge(args, rig) -> int:
 
     if args.engine not in HINGE_ENGINES:
         raise UsageError(f"--engine: {args.engine} models wires; a hinge rig runs on {' or '.join(HINGE_ENGINES)}")
-    if args.rerun:
-        raise UsageError("--rerun: recordings draw wire rigs only; leave it out for a hinge rig")
     if args.amplitude is None:
         raise UsageError(f"--amplitude: {args.rig} is a hinge rig, which has no [initial]: give the release angle, rad")
     exact = period_at(rig, args.amplitude)  # refuses a compound pendulum over the top, and nothing is known
@@ -139,6 +138,10 @@ def _run_hinge(args, rig) -> int:
         raise RunFailed(f"{args.rig}: amplitude: {exc} (--max-seconds {args.max_seconds:g}); nothing written") from None
     except NonFiniteTrajectory as exc:
         raise RigError(args.rig, "amplitude", f"the {args.engine} run failed ({exc})") from None
+    if args.rerun:
+        from ..recording import record_trajectory
+
+        record_trajectory(traj, args.rerun)
     angle = np.asarray(traj["angle"])
     print(f"{traj.engine} on {rig.name}: t = 0 .. {traj.t[-1]:.6g} s, {len(traj.t)} samples every {args.dt_out:g} s; "
           f"angle {angle.min():.6g} .. {angle.max():.6g} rad; exact period {exact:.9g} s; wrote {args.out}")
