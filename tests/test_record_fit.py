@@ -113,17 +113,6 @@ def test_a_swing_that_stays_large_keeps_its_own_third_harmonic():
     assert abs(fit.period - rec.period) < 3.0 * fit.period_std
 
 
-def _true_peaks(traits: Y.Traits, times: np.ndarray) -> np.ndarray:
-    """The noiseless motion's peak |theta| at ``times``: its turning points sampled at 4 kHz, each
-    refined by a parabola (1e-8 of the swing), ln of them interpolated (a light decay: 1e-7)."""
-    rec = Y.record(ROD, np.random.default_rng(0), Y.Traits(**{**traits.__dict__, "white": 0.0, "rate": 4000.0}))
-    a = np.abs(rec.y)
-    k = np.flatnonzero((a[1:-1] >= a[:-2]) & (a[1:-1] >= a[2:])) + 1
-    d = 0.5 * (a[k - 1] - a[k + 1]) / (a[k - 1] - 2.0 * a[k] + a[k + 1])
-    t, peak = rec.t[k] + d / 4000.0, a[k] - 0.25 * (a[k - 1] - a[k + 1]) * d
-    return np.exp(np.interp(times, t, np.log(peak)))
-
-
 def test_a_long_clean_record_has_no_second_mode_and_no_bias():
     """The rod from 0.8 rad over 100 cycles, light damping (to 0.56 rad), no noise: the periodogram of
     what the first mode leaves has a peak just past the band the first mode swept (the law's and the
@@ -136,7 +125,7 @@ def test_a_long_clean_record_has_no_second_mode_and_no_bias():
     fit = fit_oscillation(rec.t, rec.y, "angle", ROD_LAW)
     assert fit.second_mode is None
     assert fit.period == pytest.approx(rec.period, rel=1e-5)
-    assert fit.amplitude[0] == pytest.approx(_true_peaks(traits, fit.cycle_time[:1])[0], rel=1e-4)
+    assert fit.amplitude[0] == pytest.approx(Y.peaks(ROD, traits, fit.cycle_time[:1])[0], rel=1e-4)
 
 
 @pytest.mark.slow
