@@ -113,6 +113,21 @@ def test_a_swing_that_stays_large_keeps_its_own_third_harmonic():
     assert abs(fit.period - rec.period) < 3.0 * fit.period_std
 
 
+def test_a_long_clean_record_has_no_second_mode_and_no_bias():
+    """The rod from 0.8 rad over 100 cycles, light damping (to 0.56 rad), no noise: the periodogram of
+    what the first mode leaves has a peak just past the band the first mode swept (the law's and the
+    envelope's 1e-6 misfit, which no noise floor hides), and the sinusoid fitted there walked into the
+    band: it took the first mode's own misfit as a mode of 2.7e-4 of the swing, the first amplitude came
+    out 3.7e-4 high and T0 1e-4 short. A mode in the band is the first mode's (second_mode.outside):
+    none is fitted, T0 is the truth's to 2.6e-6 and the first amplitude to 2e-6."""
+    traits = Y.Traits(amplitude=0.8, cycles=100, zeta=5e-4, white=0.0)
+    rec = Y.record(ROD, np.random.default_rng(1), traits)
+    fit = fit_oscillation(rec.t, rec.y, "angle", ROD_LAW)
+    assert fit.second_mode is None
+    assert fit.period == pytest.approx(rec.period, rel=1e-5)
+    assert fit.amplitude[0] == pytest.approx(Y.peaks(ROD, traits, fit.cycle_time[:1])[0], rel=1e-4)
+
+
 @pytest.mark.slow
 def test_the_ideal_law_alone_is_biased_and_the_learned_one_is_not():
     """A record whose real law is 30 % stronger: held at the ideal law (--law-sigma 0) its T0 is off by

@@ -25,7 +25,7 @@ and assembles the result; each step is a module of its own.
    refitted; one the cycles do not show is looked for again in the whole fit's residual (step 6).
 4. The law (:mod:`.phase_law`, the ideal law: :mod:`.law`): the phases follow Phi(t) = phi0 + omega0 int
    dt / (R(A(t)) E(A(t)) D(t)), A(t) the peak amplitude (the cycles' amplitudes through the law's
-   waveform, ln A a Chebyshev series of the degree an F test allows: :class:`.phase_law._Envelope`), R
+   waveform, ln A a Chebyshev series of the degree Akaike's criterion allows: :class:`.phase_law._Envelope`), R
    the ideal law, E = 1 + ds A^2 + dq A^4 + d6 A^6 the real rig's excess with Gaussian priors, D the
    damping's shift of the frequency (:mod:`.damping`). Weighted least squares gives omega0 = 2 pi / T0,
    the zero-amplitude period, and the excess.

@@ -3,7 +3,7 @@
 Steps 4 and 5 of the record fit (:mod:`.fit`). The cycles (:mod:`.cycles`) each give a phase and an
 amplitude; :class:`Model` asks one thing of all of them together, the rig's amplitude law: A(t) the
 peak amplitude (the cycles' amplitudes through the waveform the record shows, ln A a Chebyshev series
-of the degree an F test allows: :class:`_Envelope`), R the ideal law (:mod:`.law`), E = 1 + ds A^2 +
+of the degree Akaike's criterion allows: :class:`_Envelope`), R the ideal law (:mod:`.law`), E = 1 + ds A^2 +
 dq A^4 + d6 A^6 the real rig's excess with Gaussian priors, D the damping's shift of the frequency
 (:mod:`.damping`). Weighted least squares gives omega0 = 2 pi / T0 and the excess; the covariance is
 the block sandwich of :mod:`.spread` plus what the envelope's own uncertainty adds, the priors' part
@@ -32,7 +32,13 @@ _PHASE_Z = 6.0  # a cycle's phase this many robust sigmas off the law: a slip (l
 _SLIP_FLOOR = 0.02
 _GRID_PER_CYCLE = 8  # integration points of the law's phase integral per cycle (trapezoid, smooth)
 _ENVELOPE_DEGREE = 8  # at most: ln A of a decay to a third of the start over the record needs ~5
-_ENVELOPE_F = 9.0  # one more term of the envelope must lower chi^2 by this times the residual variance
+# One more term of the envelope must lower chi^2 by this times the residual variance (Akaike's 2: a term
+# worth more than it costs). The envelope is the law's regressor: a term left out biases every record
+# alike (ln A of a light viscous decay is curved, the law's frequency shift changes the decay rate by
+# 2 % over 100 cycles from 0.8 rad; a straight line put the ends' amplitudes 3e-4 low and T0 +0.40 sigma
+# long on average over 40 white-noise records), one too many only adds variance, which the covariance
+# carries (Murphy-Topel). At 9 (an F test at ~3 sigma) it was that bias; at 2, z -0.02 +- 0.10.
+_ENVELOPE_F = 2.0
 # The real law's excess E = 1 + ds A^2 + dq A^4 + d6 A^6: a stronger cubic restoring term alone already
 # gives all three (over 0.4..1.25 rad, A^2 and A^4 alone leave 2e-4 of it, enough to bias T0 by 1e-4).
 EXCESS_TERMS = ("ds", "dq", "d6")
@@ -353,7 +359,7 @@ class Model:
 class _Envelope:
     """ln A(t) of the cycles' amplitudes as a Chebyshev series in the time scaled to [-1, 1], of the
     lowest degree past which one more term does not lower chi^2 by :data:`_ENVELOPE_F` times the
-    residual variance (an F test at ~3 sigma), at most :data:`_ENVELOPE_DEGREE`: as smooth as the decay
+    residual variance (Akaike's criterion), at most :data:`_ENVELOPE_DEGREE`: as smooth as the decay
     the record shows and no smoother. Fitted to the amplitudes alone: let the phases move it and their
     noise would pass for a law through it (an error in the regressor attenuates what it regresses).
     ``cov``: the coefficients' covariance, scaled by chi^2 per degree of freedom where that is above 1."""

@@ -17,7 +17,7 @@ from scipy.optimize import least_squares
 
 from .cycles import Cycles, Samples, highest_harmonic
 from .phase_law import Model
-from .second_mode import SECOND_DECAY_SPANS, Second, peak_apart, swept_band
+from .second_mode import SECOND_DECAY_SPANS, Second, outside, peak_apart, swept_band
 from .spread import block_length, few_blocks
 
 _SECOND_SHARE = 0.5  # the largest second mode, relative to the first mode's largest swing
@@ -75,19 +75,22 @@ def fit_whole(rec: Samples, cyc: Cycles, model: Model, baseline: np.ndarray, sec
     _, _, phi0, omega0, _, _ = model.phase_integral
     first = [phi0, omega0, math.log(float(np.median(cyc.fundamental[good])) / level), 0.0]
     largest = _SECOND_SHARE * float(np.max(envelope))
+    swept = swept_band(model, cyc.centre[good])
 
     def plausible(f) -> bool:
-        """Its second mode at most _SECOND_SHARE of the first: a law misfit near the first mode's
-        frequency would pass for one of comparable size."""
-        return math.hypot(*f[3][-2:]) * math.exp(-f[0][5] * tau[0]) <= largest
+        """Its second mode at most _SECOND_SHARE of the first (a law misfit near the first mode's
+        frequency would pass for one of comparable size) and apart from the band the first mode swept
+        (:func:`.second_mode.outside`)."""
+        scaled = tuple(w * f[0][1] / model.omega0 for w in swept)
+        return (math.hypot(*f[3][-2:]) * math.exp(-f[0][5] * tau[0]) <= largest
+                and outside(float(f[0][4]), scaled, span))
 
     fit = _whole_fit(tau, y, u, integral, envelope, level, harmonics, first, second)
     if second is not None and not plausible(fit):
         second = None
         fit = _whole_fit(tau, y, u, integral, envelope, level, harmonics, first, None)
     if second is None:
-        low, high = swept_band(model, cyc.centre[good])
-        peak = peak_apart(tau, fit[2], (low * fit[0][1] / model.omega0, high * fit[0][1] / model.omega0))
+        peak = peak_apart(tau, fit[2], tuple(w * fit[0][1] / model.omega0 for w in swept))
         if peak is not None:
             with_second = _whole_fit(tau, y, u, integral, envelope, level, harmonics, list(fit[0][:4]),
                                      Second(peak, 0.0, 0.0, 0.0))
