@@ -49,6 +49,8 @@ A proportional record (pixels) has no known scale: with ``scale`` (signal units 
 angle record; with ``max_amplitude`` (rad, the largest swing it can have had) the scale kappa is fitted
 with a prior uniform on [0, max_amplitude / first amplitude]; with neither the law cannot be applied
 (a small swing is assumed, the period is the one at the record's amplitudes) and the fit says so.
+A compound pendulum's (:func:`.phase_law.pendulum`) is the exception: its scale is read from each
+cycle's third harmonic (:func:`.phase_law.harmonic_scale`) and fitted with the law under that prior.
 """
 
 from __future__ import annotations
