@@ -90,3 +90,25 @@ def test_gyro_voltage_without_max_amplitude_covers_the_truth():
     released at 0.1-0.5 rad): at least 18 within 0.5 % of the moment and inside their 95 % interval
     (measured on this commit: 18 both, 20 of 20 inside the interval)."""
     assert sum(_good(seed) for seed in range(20)) >= 18
+
+
+@pytest.mark.parametrize("seed", [2, 3])
+def test_a_proportional_angle_record_is_read_as_an_angle(seed):
+    """Pixels of the angle (300 + 400 theta, 1 % noise), released at ~0.42 rad: the third harmonic's
+    sign (negative: an angle's -A^2 / 192) is read, and the moment is within 0.5 % and its 95 % interval."""
+    from scipy.integrate import cumulative_trapezoid
+
+    from bifilar.identification.records.read import Record
+    from test_hinge_identify import _swing
+
+    rig, axis, moment = _rig("wheel_compound", exact=True)
+    rng = np.random.default_rng(seed)
+    t, rate, _ = _swing(rig, rng, rng.uniform(5.0, 15.0))
+    draws = np.random.default_rng(seed)
+    draws.uniform(5.0, 15.0), draws.uniform(0.001, 0.01)
+    release = draws.uniform(0.1, 0.5)  # _swing's draw, in its order
+    theta = release + cumulative_trapezoid(rate, t, initial=0.0)
+    pixels = 300.0 + 400.0 * theta + rng.normal(0.0, 4.0 * release, t.size)
+    found = measure_hinge(rig, axis, signals=[Record("spot.csv", "x", "proportional", t, pixels)],
+                          options=PROPORTIONAL)
+    assert abs(found.inertia / moment - 1.0) < 0.005 and abs(found.inertia - moment) < 1.96 * found.std
