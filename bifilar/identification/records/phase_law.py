@@ -7,7 +7,9 @@ of the degree an F test allows: :class:`_Envelope`), R the ideal law (:mod:`.law
 dq A^4 + d6 A^6 the real rig's excess with Gaussian priors, D the damping's shift of the frequency
 (:mod:`.damping`). Weighted least squares gives omega0 = 2 pi / T0 and the excess; the covariance is
 the block sandwich of :mod:`.spread` plus what the envelope's own uncertainty adds, the priors' part
-apart, and a delete-a-group jackknife (:meth:`Model.jackknife`) checks it. The learned law's own doubts
+apart, and a delete-a-group jackknife (:meth:`Model.jackknife`) checks it. A proportional record of a
+compound pendulum has its scale q = kappa^2 from its own third harmonic (:func:`harmonic_scale`), a prior
+of the fit whose doubt is the law's part of T0's sigma. The learned law's own doubts
 (its extrapolation to zero swing, a law no rig has) are measured by refitting (:meth:`Model.check_law`).
 The law's local frequency and decay are what the next pass's windows are fitted with (:meth:`Model.local`).
 """
@@ -479,7 +481,9 @@ def harmonic_scale(amp: np.ndarray, third: np.ndarray, third_var: np.ndarray) ->
         chi = float(np.sum(w * (r - model(max(q, 0.0), rate)) ** 2)) / max(len(r) - 1, 1)
         return q, math.sqrt(max(chi, 1.0) / info)
 
-    lead = float(np.sum(w * r * x2) / np.sum(w * x2 * x2)) * math.sqrt(float(np.sum(w * x2 * x2)))
+    beta = float(np.sum(w * r * x2) / np.sum(w * x2 * x2))  # the leading order, r = beta amp^2
+    misfit = float(np.sum(w * (r - beta * x2) ** 2)) / max(len(r) - 1, 1)
+    lead = beta * math.sqrt(float(np.sum(w * x2 * x2)) / max(misfit, 1.0))  # in its sigmas
     if abs(lead) >= _THIRD_Z:
         q, sd = solve(lead > 0.0)
         return q, sd, lead > 0.0
