@@ -159,6 +159,8 @@ def _cycles(tau, y, usable, centres, omegas, decays, chirps, rate: bool) -> Cycl
     out.fitted_omega = np.array(omegas, dtype=float)
     out.peak_ratio = np.full(n, np.nan)
     out.amplitude_var = np.full(n, np.nan)
+    out.third = np.full(n, np.nan)  # the third harmonic over the fundamental, in the fundamental's phase
+    out.third_var = np.full(n, np.nan)
     for k, (c, w, lam, chirp) in enumerate(zip(centres, omegas, decays, chirps)):
         half = math.pi / w
         lo, hi = np.searchsorted(tau, [c - half, c + half])
@@ -190,6 +192,11 @@ def _cycles(tau, y, usable, centres, omegas, decays, chirps, rate: bool) -> Cycl
             an = coef[1 + 2 * j] * math.cos(n * phase) - coef[2 + 2 * j] * math.sin(n * phase)
             peak += an / (n if rate else 1.0)
         out.peak_ratio[k] = peak / math.sqrt(amp2)
+        if len(coef) >= 5:  # the signal's own third harmonic (a rate's not divided by 3): scale-free
+            c3, s3 = math.cos(3.0 * phase), math.sin(3.0 * phase)
+            out.third[k] = (coef[3] * c3 - coef[4] * s3) / math.sqrt(amp2)
+            g3 = np.array([c3, -s3])
+            out.third_var[k] = float(g3 @ cov[3:5, 3:5] @ g3) / amp2
         out.phase_var[k] = float(g @ cov[1:3, 1:3] @ g)
         out.fundamental[k] = math.sqrt(amp2)
         radial = np.array([a1, b1]) / math.sqrt(max(amp2, 1e-300))

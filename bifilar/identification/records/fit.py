@@ -49,6 +49,8 @@ A proportional record (pixels) has no known scale: with ``scale`` (signal units 
 angle record; with ``max_amplitude`` (rad, the largest swing it can have had) the scale kappa is fitted
 with a prior uniform on [0, max_amplitude / first amplitude]; with neither the law cannot be applied
 (a small swing is assumed, the period is the one at the record's amplitudes) and the fit says so.
+A compound pendulum's (:func:`.phase_law.pendulum`) is the exception: its scale is read from each
+cycle's third harmonic (:func:`.phase_law.harmonic_scale`) and fitted with the law under that prior.
 """
 
 from __future__ import annotations
@@ -63,7 +65,7 @@ from .bounds import Deadline, binned
 from .clean import Rejected, spans, stuck
 from .cycles import Cycles, Samples, baseline_of, measure, rough_frequency
 from .law import EXCESS_PRIOR, LINEAR, AmplitudeLaw
-from .phase_law import EXCESS_TERMS, LAW_CONFLICT, Model
+from .phase_law import EXCESS_TERMS, LAW_CONFLICT, Model, pendulum, swing_of
 from .read import KINDS, MIN_CYCLES, MIN_SAMPLES
 from .second_mode import second_mode_of
 from .spread import few_blocks
@@ -174,7 +176,8 @@ def fit_oscillation(t, y, kind: str, law: AmplitudeLaw = LINEAR, *, excess_prior
     if omega * tau[-1] / (2.0 * math.pi) < MIN_CYCLES:
         raise ValueError(f"the record holds {omega * tau[-1] / (2.0 * math.pi):.3g} cycles; at least {MIN_CYCLES} "
                          "are needed")
-    uses_law = law.kind != "linear" and (kind != "proportional" or max_amplitude is not None)
+    # a proportional record of a compound pendulum: its scale from its own third harmonic (.phase_law)
+    uses_law = law.kind != "linear" and (kind != "proportional" or max_amplitude is not None or pendulum(law))
     model = Model(law if uses_law else LINEAR, kind, excess_prior if uses_law else 0.0, max_amplitude)
     baseline = np.zeros(len(y))
     second = None
@@ -295,7 +298,7 @@ def _result(rec: Samples, t: np.ndarray, cyc: Cycles, model: Model, baseline: np
         prior_sd = model.prior * abs(model.ideal)
         learned = max(0.0, 1.0 - std[i] ** 2 / prior_sd**2) if prior_sd > 0 else 0.0
     note = ""
-    if model.kind == "proportional" and "kappa" not in names and ideal_kind != "linear":  # linear: no law to apply
+    if model.kind == "proportional" and "kappa" not in names and "q" not in names and ideal_kind != "linear":  # linear: no law to apply
         note = ("scale unknown: the ideal law cannot be applied; T0 is the period at the record's amplitudes "
                 "(a small swing assumed)")
     law = Law("none (scale unknown)" if note else model.law.kind,
@@ -330,6 +333,8 @@ def _law_curve(model: Model, period: float, amplitude: np.ndarray):
     names, p = model.names, model.params
     kappa = p[names.index("kappa")] if "kappa" in names else 1.0
     a_rad = a * kappa if model.kind == "proportional" else a
+    if "q" in names:
+        a_rad = swing_of(math.sqrt(p[names.index("q")]) * a, model.harmonic[2])
     ideal = period * model.table.ratio_at(np.minimum(a_rad, model.table.largest))
     excess = 1.0
     if "ds" in names:

@@ -7,7 +7,9 @@ of the degree Akaike's criterion allows: :class:`_Envelope`), R the ideal law (:
 dq A^4 + d6 A^6 the real rig's excess with Gaussian priors, D the damping's shift of the frequency
 (:mod:`.damping`). Weighted least squares gives omega0 = 2 pi / T0 and the excess; the covariance is
 the block sandwich of :mod:`.spread` plus what the envelope's own uncertainty adds, the priors' part
-apart, and a delete-a-group jackknife (:meth:`Model.jackknife`) checks it. The learned law's own doubts
+apart, and a delete-a-group jackknife (:meth:`Model.jackknife`) checks it. A proportional record of a
+compound pendulum has its scale q = kappa^2 from its own third harmonic (:func:`harmonic_scale`), a prior
+of the fit whose doubt is the law's part of T0's sigma. The learned law's own doubts
 (its extrapolation to zero swing, a law no rig has) are measured by refitting (:meth:`Model.check_law`).
 The law's local frequency and decay are what the next pass's windows are fitted with (:meth:`Model.local`).
 """
@@ -70,6 +72,7 @@ class Model:
         self.order_shift = 0.0  # omega0 learned less omega0 with one excess term fewer (rad/s)
         self.conflict = 0.0  # the largest excess of the last fit, in prior sigmas
         self.held_shift = 0.0  # omega0 learned less omega0 under the ideal law (rad/s), past LAW_CONFLICT
+        self.harmonic = None  # a proportional record's scale from its third harmonic (:func:`harmonic_scale`)
 
     def _table(self, omega: float, largest: float) -> Table:
         """The law's table at ``omega`` up to ``largest`` rad, recomputed when omega moves by over 1e-6
@@ -117,9 +120,19 @@ class Model:
         largest = float(amp_grid.max())
         law_on = self.law.kind != "linear"
         kappa_max = None
+        harmonic = None  # (q centre, q sd, rate): the swing's scale from the third harmonic (:func:`harmonic_scale`)
         if self.kind == "proportional":
             kappa_max = self.max_amplitude / largest if self.max_amplitude is not None else None
             largest_rad = self.max_amplitude or 0.0
+            if kappa_max is None and law_on and pendulum(self.law):
+                if self.parent is not None and self.parent.harmonic is not None:
+                    harmonic = self.parent.harmonic  # a jackknife refit: the scale's doubt is the law's part
+                else:
+                    harmonic = harmonic_scale(np.exp(envelope.basis(centre) @ envelope.beta),
+                                              cyc.third[good], cyc.third_var[good])
+                self.harmonic = harmonic
+                q_top = harmonic[0] + 6.0 * harmonic[1]
+                largest_rad = swing_of(math.sqrt(max(q_top, 0.0)) * largest, harmonic[2])
         else:
             largest_rad = largest
         s = self.law.coefficient(omega)
@@ -134,6 +147,10 @@ class Model:
             start += [0.0] * len(EXCESS_TERMS)
             priors += [(2 + j, 0.0, (_HELD if self.held or j >= self.terms else 1.0) * self.prior * abs(s))
                        for j in range(len(EXCESS_TERMS))]
+        if harmonic is not None:
+            names.append("q")
+            start.append(max(harmonic[0], 0.0))
+            priors.append((len(names) - 1, harmonic[0], harmonic[1]))
         if law_on and kappa_max is not None:
             names.append("kappa")
             start.append(0.5 * kappa_max)
@@ -160,7 +177,12 @@ class Model:
             if not law_on:
                 return amp, slow, np.zeros_like(amp), []
             kappa = p[names.index("kappa")] if "kappa" in names else 1.0
-            a = np.minimum(kappa * amp, self.table.largest)
+            if "q" in names:  # q = kappa^2; a rate's peak is 2 sin(A / 2) of the angle's (the energy)
+                x = math.sqrt(max(p[names.index("q")], 0.0)) * amp
+                a = np.minimum(swing_of(x, harmonic[2]), self.table.largest)
+                da_dx = 1.0 / np.sqrt(np.maximum(1.0 - 0.25 * x * x, 1e-12)) if harmonic[2] else np.ones_like(x)
+            else:
+                a = np.minimum(kappa * amp, self.table.largest)
             a2 = a * a
             d = p[2:2 + len(EXCESS_TERMS)] if "ds" in names else np.zeros(len(EXCESS_TERMS))
             powers = [a2 ** (j + 1) for j in range(len(EXCESS_TERMS))]
@@ -168,11 +190,16 @@ class Model:
             growth = sum(2.0 * (j + 1) * dj * a2**j for j, dj in enumerate(d))  # dE/da / a
             ratio = self.table.ratio_at(a)
             g = slow / (ratio * excess)
-            dg_da = -g * (self.table.ratio_slope(a) / ratio + growth * a / excess)
-            dg_dlna = a * dg_da
+            # d g / d a over a, finite at a = 0 (R is even in A)
+            floor = np.maximum(a, 1e-6)
+            dg_da_a = -g * (self.table.ratio_slope(floor) / floor / ratio + growth / excess)
+            dg_da = dg_da_a * a
+            dg_dlna = a * dg_da if "q" not in names else dg_da_a * a * x * da_dx
             slopes = [-g * pw / excess for pw in powers] if "ds" in names else []
             if "kappa" in names:  # d g / d kappa = A d g / d a: finite at kappa = 0, where a is 0
                 slopes.append(amp * dg_da)
+            if "q" in names:  # d g / d q = (d g / d a) (d a / d x) amp^2 / (2 x): finite at q = 0
+                slopes.append(dg_da_a * np.where(x > 1e-9, a / np.maximum(x, 1e-300), 1.0) * da_dx * amp * amp / 2.0)
             return a, g, dg_dlna, slopes
 
         def integral(f):
@@ -211,6 +238,8 @@ class Model:
             new[1] = min(max(new[1], 0.5 * omega), 2.0 * omega)
             if "kappa" in names:
                 new[names.index("kappa")] = max(new[names.index("kappa")], 0.0)
+            if "q" in names:
+                new[names.index("q")] = max(new[names.index("q")], 0.0)
             done = abs(new[1] - p[1]) <= 1e-14 * p[1] and np.all(np.abs(step[2:]) <= 1e-12 * (1.0 + np.abs(p[2:])))
             p = new
             if done:
@@ -225,7 +254,7 @@ class Model:
         self.residual, self.var = r_phase / weights, var
         self.ideal = s if law_on else None
         self.damping = damping
-        self.scale_known = self.kind != "proportional" or "kappa" in names
+        self.scale_known = self.kind != "proportional" or "kappa" in names or "q" in names
         amp_signal = amp_grid
         slope = envelope.basis(grid, derivative=1) @ envelope.beta
         self.fund_at = lambda tt: np.interp(tt, grid, amp_signal)
@@ -314,7 +343,7 @@ class Model:
         """The variance of omega0 that the law's parameters carry (their own uncertainty, the record's and
         the priors'): Sigma_wL Sigma_LL^-1 Sigma_Lw of the whole covariance, the part a fit holding the
         law at its estimate does not see."""
-        law = [i for i, n in enumerate(self.names) if n in EXCESS_TERMS or n == "kappa"]
+        law = [i for i, n in enumerate(self.names) if n in EXCESS_TERMS or n in ("kappa", "q")]
         if not law:
             return 0.0
         cov = self.cov_stat + self.cov_law
@@ -392,6 +421,80 @@ class _Envelope:
             c[k] = 1.0
             cols.append(C.chebval(u, C.chebder(c, derivative) if derivative else c) / half**derivative)
         return np.column_stack(cols)
+
+
+# A compound pendulum's (theta'' = -omega^2 sin theta) waveform: theta = A cos(phi) + a3 cos(3 phi) + ..,
+# a3 / A = -(A^2 / 192) H(A) (Lindstedt: the Duffing eps A^2 / 32 with eps = -1/6), and a rate's third
+# harmonic over its fundamental, in its own phase, -3 a3 / A = +(A^2 / 64) H(A), with
+# H = 1 + 0.0573 A^2 + 0.0039 A^4 fitted to the exact solution's Fourier coefficients (DOP853, rtol 1e-12)
+# over 0.1..0.8 rad, right to 2e-4 of the ratio there (tests/test_gyro_scale.py).
+_THIRD_H = (0.0573, 0.0039)
+_THIRD_Z = 3.0  # the third harmonic this many sigmas from zero: its sign says rate (+) or angle (-)
+
+
+def pendulum(law) -> bool:
+    """Whether ``law`` is a compound pendulum's, theta'' = -omega^2 sin(theta) (:func:`..hinge.law_for_hinge`),
+    whose waveform :func:`harmonic_scale` knows."""
+    return law.kind == "exact" and law.rho == 0.0 and law.lam == 0.0
+
+
+def swing_of(x, rate: bool):
+    """The angle's amplitude (rad) of a peak ``x`` (the signal's peak times kappa): a rate's peak is
+    2 sin(A / 2) omega0 (the energy), an angle's is A."""
+    return 2.0 * np.arcsin(np.minimum(0.5 * np.asarray(x), 1.0)) if rate else np.asarray(x)
+
+
+def third_ratio(a, rate: bool):
+    """The third harmonic over the fundamental of a pendulum swinging at ``a`` rad: + for a rate, - for an
+    angle (the constants above)."""
+    a2 = np.asarray(a) ** 2
+    h = 1.0 + _THIRD_H[0] * a2 + _THIRD_H[1] * a2 * a2
+    return a2 * h / 64.0 if rate else -a2 * h / 192.0
+
+
+def harmonic_scale(amp: np.ndarray, third: np.ndarray, third_var: np.ndarray) -> tuple[float, float, bool]:
+    """(q, its sd, rate) of a proportional record of a compound pendulum: q = kappa^2, kappa the scale
+    (rad of swing per signal unit of peak), from each cycle's third harmonic over its fundamental
+    (``third``, variances ``third_var``) at its peak ``amp`` (signal units): weighted least squares of
+    :func:`third_ratio`, the sd scaled by the misfit where chi^2 / dof is above 1. Its sign says
+    whether the record is a rate (+) or an angle (-) where it is :data:`_THIRD_Z` sigmas from zero;
+    where it is not (a swing of ~0.1 rad in 1 % noise), q is taken uniform on [0, the larger of the two
+    readings' estimate + 2 sd] (centre and sd of that), so that its doubt is honest in T0's sigma."""
+    ok = np.isfinite(third) & np.isfinite(third_var) & (third_var > 0.0)
+    if ok.sum() < 2:
+        return 0.0, 0.0, True
+    amp, r, w = amp[ok], third[ok], 1.0 / third_var[ok]
+    x2 = amp * amp
+
+    def model(q, rate):
+        return third_ratio(swing_of(math.sqrt(q) * amp, rate), rate)
+
+    def solve(rate):
+        c = 64.0 if rate else -192.0
+        sxx = float(np.sum(w * x2 * x2))
+        q = c * float(np.sum(w * r * x2)) / sxx
+        if q > 0.0:  # Gauss-Newton on q (a numeric slope), from the leading order
+            for _ in range(20):
+                d = (model(q * 1.000001, rate) - model(q * 0.999999, rate)) / (2e-6 * q)
+                step = float(np.sum(w * d * (r - model(q, rate))) / np.sum(w * d * d))
+                q = max(q + step, 1e-3 * q)
+                if abs(step) <= 1e-10 * q:
+                    break
+            d = (model(q * 1.000001, rate) - model(q * 0.999999, rate)) / (2e-6 * q)
+            info = float(np.sum(w * d * d))
+        else:
+            info = sxx / (c * c)
+        chi = float(np.sum(w * (r - model(max(q, 0.0), rate)) ** 2)) / max(len(r) - 1, 1)
+        return q, math.sqrt(max(chi, 1.0) / info)
+
+    beta = float(np.sum(w * r * x2) / np.sum(w * x2 * x2))  # the leading order, r = beta amp^2
+    misfit = float(np.sum(w * (r - beta * x2) ** 2)) / max(len(r) - 1, 1)
+    lead = beta * math.sqrt(float(np.sum(w * x2 * x2)) / max(misfit, 1.0))  # in its sigmas
+    if abs(lead) >= _THIRD_Z:
+        q, sd = solve(lead > 0.0)
+        return q, sd, lead > 0.0
+    top = max(max(q, 0.0) + 2.0 * sd for q, sd in (solve(True), solve(False)))
+    return 0.5 * top, top / math.sqrt(12.0), lead > 0.0
 
 
 def _waveform(a1: np.ndarray, peak_ratio: np.ndarray) -> np.ndarray:
