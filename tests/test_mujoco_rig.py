@@ -111,7 +111,10 @@ def test_slack_wire_pulls_nothing():
     slack = tendon["length_error"] < -1e-9
     assert slack.sum() > 50
     assert np.all(tendon["tension"][slack] == 0.0)
-    assert np.all(tendon["tension"][tendon["length_error"] > 0.0] > 0.0)
+    # A stretched one pulls; within the soft stretch (|error| < 1e-9 m) a tendon retautening on this very
+    # sample may not pull yet (at t = 1.5 s wire 1 is 4e-11 m long with no force, or 1e-16 m short with
+    # it, as the rest pose's last bits fall with the BLAS's thread count).
+    assert np.all(tendon["tension"][tendon["length_error"] > 1e-9] > 0.0)
     # The equality cable cannot go slack: it pushes instead.
     assert rope["tension"][first, wire - 1] < 0.0
     assert np.abs(rope["length_error"]).max() < 1e-7
