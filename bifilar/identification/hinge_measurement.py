@@ -74,10 +74,19 @@ def _with_period_sigma(rig: HingeRig, sigma: float) -> HingeRig:
     return replace(rig, uncertainty=replace(rig.uncertainty, period=sigma))
 
 
-def _pooled(rig: HingeRig, signals: Sequence, options: RecordOptions, quantity: str):
-    """The records' trials, their pool and flags, and the rig with the pooled period's sigma."""
+def _found(rig: HingeRig, invert, quantity: str, period, amplitude, signals, options):
+    """``invert(rig, period, amplitude)`` of a timed period or of the records' pooled one: (the result,
+    the rig with the period sigma used, where that sigma came from, trials, pool, flags)."""
+    if signals is None:
+        source = ("the rig file's [uncertainty].period" if rig.uncertainty.period > 0.0
+                  else "none: the rig file states no [uncertainty].period")
+        return invert(rig, period, amplitude or 0.0), rig, source, (), None, []
+    if quantity == "stiffness":
+        invert(rig, 1.0, 0.0)  # a pivot or an unknown moment refused before any record is read
     trials, pooled = identify_records(rig, None, list(signals), options, target=hinge_target(rig, quantity))
-    return tuple(trials), pooled, record_flags(trials, pooled), _with_period_sigma(rig, pooled.period_std)
+    used = _with_period_sigma(rig, pooled.period_std)
+    flags = record_flags(trials, pooled)
+    return invert(used, pooled.period, 0.0), used, "the records' fits", tuple(trials), pooled, flags
 
 
 def measure_hinge(rig: HingeRig, axis: str, *, period: float | None = None, amplitude: float | None = None,
@@ -87,17 +96,8 @@ def measure_hinge(rig: HingeRig, axis: str, *, period: float | None = None, ampl
     trials of this rig, pooled), propagated linearly (module docstring). Raises :class:`RigError` for a
     period no body gives (field ``period``) and for records that cannot be used."""
     k = hinge_axis(rig, axis)
-    trials: tuple[Trial, ...] = ()
-    pooled: Pooled | None = None
-    flags: list[str] = []
-    if signals is None:
-        found = moment_from_period(rig, period, amplitude or 0.0)
-        propagated_rig, std_source = rig, ("the rig file's [uncertainty].period" if rig.uncertainty.period > 0.0
-                                           else "none: the rig file states no [uncertainty].period")
-    else:
-        trials, pooled, flags, propagated_rig = _pooled(rig, signals, options, "moment")
-        found = moment_from_period(propagated_rig, pooled.period)
-        std_source = "the records' fits"
+    found, propagated_rig, std_source, trials, pooled, flags = _found(rig, moment_from_period, "moment", period,
+                                                                      amplitude, signals, options)
     ratio = found.period / found.period0
     period_std = propagated_rig.uncertainty.period / ratio
     j, m = found.moment, rig.mass
@@ -194,21 +194,11 @@ def calibrate_rod(rig: HingeRig, *, period: float | None = None, amplitude: floa
                   signals: Sequence | None = None, options: RecordOptions = RecordOptions()) -> Calibration:
     """The stiffness of ``rig``'s torsion rod from the period of its body of known moment (the file's
     tensor or cylinder), timed (``period`` s at ``amplitude`` rad) or from ``signals`` (pooled trials),
-    with its sigma from the period's, the mass's and a cylinder's radius and length. A stiffness in the file is not used (it is what is
-    measured): a flag compares it with the one found. Raises :class:`RigError` for a pivot rig or a body
+    with its sigma from the period's, the mass's and a cylinder's radius and length. A stiffness in the file
+    is not used (it is what is measured): a flag compares it with the one found. Raises :class:`RigError` for a pivot rig or a body
     whose moment about the rod is unknown."""
-    trials: tuple[Trial, ...] = ()
-    pooled: Pooled | None = None
-    flags: list[str] = []
-    if signals is None:
-        found = stiffness_from_period(rig, period, amplitude or 0.0)
-        used, source = rig, ("the rig file's [uncertainty].period" if rig.uncertainty.period > 0.0
-                             else "none: the rig file states no [uncertainty].period")
-    else:
-        stiffness_from_period(rig, 1.0)  # a pivot or an unknown moment refused before any record is read
-        trials, pooled, flags, used = _pooled(rig, signals, options, "stiffness")
-        found = stiffness_from_period(used, pooled.period)
-        source = "the records' fits"
+    found, used, source, trials, pooled, flags = _found(rig, stiffness_from_period, "stiffness", period, amplitude,
+                                                        signals, options)
     if rig.stiffness is not None:
         off = f"{100.0 * (rig.stiffness / found.stiffness - 1.0):+.3g} %" + (
             f", {(rig.stiffness - found.stiffness) / found.std:+.2g} sigma" if found.std > 0.0 else "")
