@@ -15,7 +15,7 @@ inertia tensors; and three-wire platforms.
 
 import numpy as np
 import pytest
-from hypothesis import assume, given, settings
+from hypothesis import assume, example, given, settings
 from hypothesis import strategies as st
 from scipy.spatial.transform import Rotation
 
@@ -136,7 +136,10 @@ def _check(data):
     top = abs(theirs).max()
     keep = theirs > 1e-6 * top  # neutral directions: both ~0, compared absolutely below
     assert len(ours) == len(theirs)
-    np.testing.assert_allclose(ours[keep], theirs[keep], rtol=1e-5)
+    # The independent side rounds absolutely: its fourth-order second difference of V ~ m g z at h = 1e-3
+    # size loses ~eps |V| / h^2 ~ 1e-9 of m g per entry, ~1e-8 of the top omega^2 with the stencil's weights;
+    # a mode 1e-5 of the top (a nearly neutral sway) is only good to that, not to 1e-5 of itself.
+    np.testing.assert_allclose(ours[keep], theirs[keep], rtol=1e-5, atol=1e-8 * top)
     np.testing.assert_allclose(ours[~keep], theirs[~keep], atol=1e-5 * top)
     # Deterministic: the same rig twice gives the same numbers bit for bit.
     again = linearize(rig_from_dict(data))
@@ -146,6 +149,9 @@ def _check(data):
 
 @settings(max_examples=25)
 @given(two_wire_rigs())
+@example({"body": {"mass": 1.0, "com": [0.0, 0.0, 0.0], "inertia": np.eye(3).tolist()},  # CI's draw: a sway
+          "wire": [{"anchor": [0.0, -1.0, 1.0], "attach": [0.0, -1.0, 2e-05], "length": 1.0},  # 1e-5 of the
+                   {"anchor": [0.0, 1.0, 1.0], "attach": [0.0, 1.0, 0.0], "length": 1.0}]})  # top, off 3e-8
 def test_two_wire_modes_match_an_independent_linearisation(data):
     _check(data)
 
