@@ -409,4 +409,5 @@ def test_the_default_run_excludes_the_long_profile():
 
     config = tomllib.loads((Path(__file__).resolve().parents[1] / "pyproject.toml").read_text())
     pytest_config = config["tool"]["pytest"]["ini_options"]
-    assert "-m 'not fuzz'" in pytest_config["addopts"] and any(m.startswith("fuzz:") for m in pytest_config["markers"])
+    assert "-m 'not fuzz and not long'" in pytest_config["addopts"]
+    assert all(any(m.startswith(f"{tier}:") for m in pytest_config["markers"]) for tier in ("fuzz", "long"))
