@@ -264,6 +264,14 @@ class Model:
         cum = np.concatenate([[0.0], np.cumsum(0.5 * (g_fit[1:] + g_fit[:-1]) * np.diff(grid))])
         cum = cum - float(np.interp(at_ref, np.arange(len(grid)), cum))
         self.phase_integral = (grid, cum, float(p[0]), float(p[1]), float(g_fit[0]), float(g_fit[-1]))
+        # the integral's response to each law parameter (names[2:]) and their priors' sds, for the
+        # Cramér-Rao bound of a whole fit with the law free (:mod:`.bound`)
+        self.law_slopes = []
+        for d in terms(p)[3]:
+            dcum = np.concatenate([[0.0], np.cumsum(0.5 * (d[1:] + d[:-1]) * np.diff(grid))])
+            self.law_slopes.append((grid, dcum - float(np.interp(at_ref, np.arange(len(grid)), dcum)),
+                                    float(d[0]), float(d[-1])))
+        self.law_prior_sd = np.array([sd for _, _, sd in sorted(priors)])
         self._covariance(j_phase, jp, r_phase, j_envelope, envelope.cov)
 
     def unwrap(self, cyc: Cycles, good: np.ndarray, grid: np.ndarray) -> np.ndarray:
@@ -330,9 +338,11 @@ class Model:
         """int dt / (R E D) from the reference time to ``tt`` (s), carried on at the end rates beyond the
         first and last cycle: the phase is phi0 + omega0 times this."""
         grid, cum, _, _, g0, g1 = self.phase_integral
-        inside = np.interp(tt, grid, cum)
-        inside = np.where(tt < grid[0], cum[0] + g0 * (tt - grid[0]), inside)
-        return np.where(tt > grid[-1], cum[-1] + g1 * (tt - grid[-1]), inside)
+        return _carried(tt, grid, cum, g0, g1)
+
+    def law_integrals_at(self, tt: np.ndarray) -> np.ndarray:
+        """d :meth:`integral_at` / d p for each law parameter p (``names[2:]``), an (n, m) array."""
+        return np.column_stack([_carried(tt, *slope) for slope in self.law_slopes] or [np.zeros((len(tt), 0))])
 
     def phase_at(self, tt: np.ndarray) -> np.ndarray:
         """The fitted law's phase Phi at times ``tt`` (the cycles' fundamental is A cos Phi)."""
@@ -495,6 +505,13 @@ def harmonic_scale(amp: np.ndarray, third: np.ndarray, third_var: np.ndarray) ->
         return q, sd, lead > 0.0
     top = max(max(q, 0.0) + 2.0 * sd for q, sd in (solve(True), solve(False)))
     return 0.5 * top, top / math.sqrt(12.0), lead > 0.0
+
+
+def _carried(tt, grid, cum, g0, g1):
+    """The integral ``cum`` on ``grid`` at ``tt``, carried on at the end rates g0, g1 beyond it."""
+    inside = np.interp(tt, grid, cum)
+    inside = np.where(tt < grid[0], cum[0] + g0 * (tt - grid[0]), inside)
+    return np.where(tt > grid[-1], cum[-1] + g1 * (tt - grid[-1]), inside)
 
 
 def _waveform(a1: np.ndarray, peak_ratio: np.ndarray) -> np.ndarray:

@@ -15,6 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import least_squares
 
+from .bound import Bound, cramer_rao
 from .cycles import Cycles, Samples, highest_harmonic
 from .phase_law import Model
 from .second_mode import SECOND_DECAY_SPANS, Second, outside, peak_apart, swept_band
@@ -26,8 +27,8 @@ _SECOND_SHARE = 0.5  # the largest second mode, relative to the first mode's lar
 @dataclass
 class Whole:
     """The whole record fitted at once, the law held (:func:`fit_whole`): omega0 (rad/s) and its
-    statistical variance, the batch block (cycles), the refined second mode, the model at the samples
-    used and their indices."""
+    statistical variance, its white-noise variance, the batch block (cycles), the refined second mode,
+    the model at the samples used and their indices, and the Cramér-Rao bound of omega0 (:mod:`.bound`)."""
 
     omega0: float
     variance: float
@@ -36,6 +37,7 @@ class Whole:
     second: Second | None
     fitted: np.ndarray
     index: np.ndarray
+    bound: Bound
 
 
 def fit_whole(rec: Samples, cyc: Cycles, model: Model, baseline: np.ndarray, second: Second | None) -> Whole:
@@ -112,8 +114,13 @@ def fit_whole(rec: Samples, cyc: Cycles, model: Model, baseline: np.ndarray, sec
     if second is not None:
         c2, s2 = beta[-2:]
         refined = Second(float(q[4]), float(q[5]), float(c2), float(s2))
+    # the law's parameters, held here, in the bound with their priors: the fundamental's response to them
+    # (the harmonics' and a rate's envelope's, a few % of it, left out)
+    law = (np.exp(q[2] + q[3] * u) * envelope * np.sin(q[0] + q[1] * integral))[:, None] * q[1] \
+        * model.law_integrals_at(tau)
+    bound = cramer_rao(tau, r, jac, rec.step, 1, law, model.law_prior_sd)
     return Whole(float(q[1]), float(max(white[1, 1], sandwich[1, 1])), float(white[1, 1]), int(block), refined,
-                  model_y + baseline[idx], idx)
+                 model_y + baseline[idx], idx, bound)
 
 
 def _whole_fit(tau, y, u, integral, envelope, level, harmonics, first, second):
