@@ -283,6 +283,9 @@ def print_trial(i: int, tr: dict, key: str = "inertia", symbol: str = "I", unit:
     say(f"trial {i} {tr['source']}: T0 {tr['period']:.9g} +- {tr['period_std']:.3g} s (record "
         f"{tr['period_std_statistical']:.2g}, amplitude law {tr['period_std_law']:.2g}), {symbol} {tr[key]:.9g} "
         f"+- {tr['std']:.3g} {unit}")
+    if tr["crb_ratio"] is not None:
+        say(f"T0 sigma (record) {tr['period_std_statistical']:.2g} s = {tr['crb_ratio']:.2f}x the Cramér-Rao bound "
+            f"{tr['crb']:.2g} s ({tr['crb_noise']} noise)", 4)
     amp, d = tr["amplitude"], tr["damping"]
     swing = f"{amp[0]:.3g} -> {amp[1]:.3g} rad" if amp else "swing in rad unknown (proportional)"
     second = tr["second_mode"]

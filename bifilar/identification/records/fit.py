@@ -113,7 +113,9 @@ class OscillationFit:
     records of one rig share that error (pooling). ``amplitude``: peak rotation in the first and last
     cycle (None where the scale is unknown). ``cycle_*``: the measured cycles. ``jackknife``: the groups
     of cycles of the jackknife that set the statistical sigma (0: the covariance held;
-    :meth:`.phase_law.Model.jackknife`).
+    :meth:`.phase_law.Model.jackknife`). ``crb``: the Cramér-Rao bound's sigma of T0 (s) for the whole
+    fit's model (the law's shape held) and the noise its residual shows, judged ``crb_noise`` ('white'
+    or 'coloured'; :mod:`.bound`): ``period_std_statistical / crb`` is how far the fit is from efficient.
     """
 
     period: float
@@ -144,6 +146,8 @@ class OscillationFit:
     fitted: np.ndarray  # the model at every sample time (nan where no cycle covers it)
     kept: np.ndarray  # boolean mask of the samples used
     binned: int = 1  # a dense record's samples a bin (:func:`.bounds.binned`): t, y and samples are the bins'
+    crb: float = math.nan  # s, the Cramér-Rao bound's sigma of T0 (:mod:`.bound`)
+    crb_noise: str = ""  # the noise the bound assumed: 'white' or 'coloured'
 
 
 def fit_oscillation(t, y, kind: str, law: AmplitudeLaw = LINEAR, *, excess_prior: float = EXCESS_PRIOR,
@@ -321,7 +325,7 @@ def _result(rec: Samples, t: np.ndarray, cyc: Cycles, model: Model, baseline: np
                                                  second.decay),
         block=whole.block, jackknife=groups, samples=int(kept.sum()), cycles=int(good.sum()), cycle_time=t[0] + centre,
         cycle_period=per_cycle, cycle_amplitude=cycle_amp, law_curve=curve, t=t, y=rec.y, fitted=fitted, kept=kept,
-        binned=rec.binned)
+        binned=rec.binned, crb=to_period * math.sqrt(whole.bound.variance), crb_noise=whole.bound.noise)
 
 
 def _law_curve(model: Model, period: float, amplitude: np.ndarray):
