@@ -17,6 +17,17 @@ residual variance times (J^T J)^-1.
 Prints, over the records: the share of 95 % intervals holding the truth for each fit (with the
 binomial 99.9 % lower bound of a calibrated sigma), the median ratios ours / plain and ours / bound
 (ours: the statistical sigma), and the noise the bound judged.
+
+Measured (2 shared cores, 60 s a run):
+
+    --records 40 (the laser's drift, 0-2 mrad)   ours 36/40 cover, plain 18/40 (lower bound 33); rms z ours 1.2,
+                                                 plain 3.56; median ours / plain 1.13, ours / bound 1.17
+    --records 40 --drift 0                       ours 39/40, plain 38/40; rms z 0.92 and 1.0; median ours /
+                                                 plain 1.03, ours / bound 1.05
+
+The plain fit's linear drift term does not hold the offset's wander (a few sinusoids of 10-40 periods:
+curved over 6 cycles), whose error it does not state; ours subtracts a baseline smoothed across cycles
+and states its sigma from the residual's blocks, ~1.1x the plain one's and the bound.
 """
 
 from __future__ import annotations

@@ -43,7 +43,9 @@ and assembles the result; each step is a module of its own.
 6. The whole record (:mod:`.whole`): every kept sample fitted at once with the law's shape held, for the
    efficiency of a plain damped-sine fit; its sandwich over cycles (scaled to the Student-t interval of
    its few blocks: :func:`.spread.few_blocks`) plus what the law's uncertainty adds is the statistical
-   sigma of T0.
+   sigma of T0. Beside it, the Cramér-Rao bound of T0 (:mod:`.bound`) for that model with the law's
+   parameters free under their priors, and the noise its residual shows (white, or coloured: an
+   autoregressive spectrum): how far the sigma is from the smallest any unbiased fit could state.
 
 A proportional record (pixels) has no known scale: with ``scale`` (signal units per rad) it is an
 angle record; with ``max_amplitude`` (rad, the largest swing it can have had) the scale kappa is fitted

@@ -4,7 +4,8 @@ Step 6 of the record fit (:mod:`.fit`). A cycle measured alone (:mod:`.cycles`) 
 information on its own offset, envelope and harmonics, and a record of a few cycles gives only a few
 phases; :func:`fit_whole` fits every kept sample with one phase law (:mod:`.phase_law`, its shape held
 as the cycles gave it), one envelope and one second mode (:mod:`.second_mode`), and states omega0's
-sandwich over cycles, scaled to the Student-t interval of its few blocks (:mod:`.spread`).
+sandwich over cycles, scaled to the Student-t interval of its few blocks (:mod:`.spread`), and the
+Cramér-Rao bound of omega0 for the same model and the noise its residual shows (:mod:`.bound`).
 """
 
 from __future__ import annotations
