@@ -14,12 +14,18 @@ output, failing any test that asserts a one-line error or an empty stderr, depen
 tests run in. The notes are therefore marked as given for the whole session; tests/test_jit.py checks
 them with a fresh record of its own.
 
+The long tiers, ``fuzz`` and ``long``, run only when asked for by name (``-m fuzz``, ``-m long``):
+:func:`pytest_collection_modifyitems` deselects them otherwise, so that a tier chosen by another ``-m``
+(the quick tier's ``-m "not slow"``, which replaces any ``-m`` of the default options) still leaves them
+out.
+
 One BLAS thread per test worker, as ``python -m validate`` sets it (``validate/__main__.py``): set here,
 before anything imports numpy, so that pytest's two workers do not each run OpenBLAS's threads on the two
 cores.
 """
 
 import os
+import re
 import sys
 from pathlib import Path
 
@@ -42,6 +48,22 @@ _QUIET = [HealthCheck.filter_too_much, HealthCheck.too_slow, HealthCheck.data_to
 settings.register_profile("ci", derandomize=True, database=None, deadline=None, suppress_health_check=_QUIET)
 settings.register_profile("fuzz", derandomize=False, database=None, deadline=None, suppress_health_check=_QUIET)
 settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "ci"))
+
+
+LONG_TIERS = ("fuzz", "long")
+
+
+def left_out(markexpr: str) -> set[str]:
+    """The long tiers a run with ``-m markexpr`` leaves out: those its expression does not name."""
+    return {tier for tier in LONG_TIERS if not re.search(rf"\b{tier}\b", markexpr or "")}
+
+
+def pytest_collection_modifyitems(config, items):
+    tiers = left_out(config.getoption("markexpr"))
+    dropped = [item for item in items if any(item.get_closest_marker(t) for t in tiers)]
+    if dropped:
+        config.hook.pytest_deselected(items=dropped)
+        items[:] = [item for item in items if item not in set(dropped)]
 
 
 @pytest.fixture(params=["plate", "parallel", "asymmetric", "sidesway"])

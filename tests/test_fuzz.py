@@ -19,6 +19,8 @@ import functools
 import json
 import re
 import shutil
+import subprocess
+import sys
 import time
 from pathlib import Path
 
@@ -404,10 +406,19 @@ def test_the_long_profile_holds_ten_thousand_examples():
     assert sum(long for _, long in EXAMPLES.values()) >= 10_000
 
 
-def test_the_default_run_excludes_the_long_profile():
-    import tomllib
+def test_the_long_tiers_run_only_when_named():
+    # -m on the command line replaces the default options' -m, so the tiers are left out by the conftest's
+    # hook, whatever other expression chooses the run (the quick tier's "not slow" ran the 5-minute study)
+    from conftest import left_out
 
-    config = tomllib.loads((Path(__file__).resolve().parents[1] / "pyproject.toml").read_text())
-    pytest_config = config["tool"]["pytest"]["ini_options"]
-    assert "-m 'not fuzz and not long'" in pytest_config["addopts"]
-    assert all(any(m.startswith(f"{tier}:") for m in pytest_config["markers"]) for tier in ("fuzz", "long"))
+    assert left_out("") == left_out("not slow") == {"fuzz", "long"}
+    assert left_out("long") == {"fuzz"} and left_out("fuzz and not slow") == {"long"}
+    assert left_out("longer") == {"fuzz", "long"}  # a word, not a substring
+
+
+def test_the_quick_tier_collects_no_long_study():
+    root = Path(__file__).resolve().parents[1]
+    run = subprocess.run([sys.executable, "-m", "pytest", "tests/test_record_sigma.py", "-m", "not slow", "--collect-only",
+                          "-q", "-p", "no:cacheprovider"], cwd=root, capture_output=True, text=True)
+    assert run.returncode == 0, run.stdout[-500:]
+    assert "unbiased[200" not in run.stdout and "deselected" in run.stdout.splitlines()[-1]
