@@ -110,12 +110,13 @@ def _announce_compile() -> bool:
     whether they will."""
     from bifilar import jit, smallmat
     from bifilar.identification import slopes_kernel
+    from bifilar.identification.records import damping
     from bifilar.motion import kane_kernel, nwire_kernel
     from bifilar.rig import pose_kernel
     from bifilar.seeds import tmt
     from bifilar.sweep import kernel as sweep_kernel
 
-    modules = (smallmat, kane_kernel, nwire_kernel, tmt, pose_kernel, slopes_kernel, sweep_kernel)
+    modules = (smallmat, kane_kernel, nwire_kernel, tmt, pose_kernel, slopes_kernel, sweep_kernel, damping)
     return jit.announce_modules("the Kane, N-wire, TMT and pose kernels", modules, seconds=COMPILE_SECONDS)
 
 

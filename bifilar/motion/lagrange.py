@@ -161,9 +161,16 @@ def lift_slope(rig: TorsionRig, theta):
 
 def lift_curvature(rig: TorsionRig, theta):
     """z''(theta) = b D cos(theta) / (4 w) + z'^2 / w (m/rad^2), using w' = -z'."""
+    return _slope_and_curvature(rig, theta)[1]
+
+
+def _slope_and_curvature(rig: TorsionRig, theta):
+    """(z'(theta), z''(theta)) of :func:`lift_slope` and :func:`lift_curvature`, the same arithmetic with w
+    computed once: :func:`exact_acceleration` is a synthetic record's right-hand side, called ~10^4 times
+    a record."""
     w = _reach(rig, theta)
     slope = rig.hook_span * rig.attach_span * np.sin(theta) / (4.0 * w)
-    return rig.hook_span * rig.attach_span * np.cos(theta) / (4.0 * w) + slope**2 / w
+    return slope, rig.hook_span * rig.attach_span * np.cos(theta) / (4.0 * w) + slope**2 / w
 
 
 def stiffness(rig: TorsionRig) -> float:
@@ -190,7 +197,7 @@ def exact_acceleration(rig: TorsionRig, theta, theta_dot):
     Lagrange's equation: (I + m z'^2) theta'' + m z' z'' theta'^2 + m g z' = 0.
     """
     m = rig.mass
-    slope, curv = lift_slope(rig, theta), lift_curvature(rig, theta)
+    slope, curv = _slope_and_curvature(rig, theta)
     return -m * slope * (curv * theta_dot**2 + rig.gravity) / (rig.inertia + m * slope**2)
 
 

@@ -16,9 +16,8 @@ from dataclasses import dataclass
 
 import numpy as np
 from scipy.optimize import least_squares
-from scipy.signal import lombscargle
 
-from .cycles import PERIODOGRAM_SAMPLES, Cycles, Samples, highest_harmonic
+from .cycles import PERIODOGRAM_SAMPLES, Cycles, Samples, highest_harmonic, periodogram
 from .phase_law import Model
 from .read import MIN_CYCLES
 
@@ -50,7 +49,7 @@ def peak_apart(tau: np.ndarray, rest: np.ndarray, swept: tuple[float, float]) ->
         return None
     near = ((grid > low - resolution) & (grid < high + resolution)) | (grid < 2.0 * resolution)
     near |= (grid > 3.0 * low - 4.0 * resolution) & (grid < 3.0 * high + 4.0 * resolution)
-    power = np.where(near, 0.0, lombscargle(x, v, grid, floating_mean=True))
+    power = np.where(near, 0.0, periodogram(x, v, grid))
     j = int(np.argmax(power))
     band = (grid > 0.5 * grid[j]) & (grid < 2.0 * grid[j]) & ~near & (np.abs(grid - grid[j]) > 3.0 * resolution)
     if band.sum() >= 8:
