@@ -173,9 +173,31 @@ def test_a_tracker_locking_on_losing_frames_and_sticking_is_fitted_and_says_what
 
 
 @pytest.mark.slow
+def test_a_large_swing_with_a_sway_near_twice_its_frequency_read_from_a_tracker_file(tmp_path):
+    """Issue 37 item 3: 1.15 rad on a 60 fps tracker, a sway at 0.496 T0 with 14 % of the swing, runs of
+    ~20 lost frames, 1.5 s of lock-on. Never folded, but over a lost run at full speed (the sway doubles
+    the rate) and in the lock-on the angle steps by over pi/2; read_record took three such steps for folds
+    and put the pieces between them pi apart: "no oscillation stands out of the noise" (2.9 < 3). Now the
+    file is read as written and fitted within 3 sigma (measured z +0.16; 30 records of these traits drawn
+    at random: all fitted, rms z 0.74)."""
+    from bifilar.identification.records.read import read_record
+
+    traits = Y.Traits(kind="angle", rate=60.0, amplitude=1.15, cycles=19.4, excess=0.3, shape=-0.15, zeta=2.4e-4,
+                      quadratic=2e-3, dry=1.4e-3, white=0.0018, coloured=0.0054, colour_time=0.16, offset=-0.047,
+                      drift=0.01, lost=0.113, burst=19.6, lockon=1.49, holds=0.0032, glitches=0.0017,
+                      second=(0.496, 0.144, 0.0077))
+    rec = Y.record(ROD, np.random.default_rng(4), traits)
+    Y.write_tracker_csv(tmp_path / "video.csv", rec)
+    read = read_record(tmp_path / "video.csv", fps=60.0)
+    assert read.unfolded == 0
+    fit = fit_oscillation(read.t, read.y, "angle", ROD_LAW)
+    assert abs(fit.period - rec.period) < 3.0 * fit.period_std
+
+
+@pytest.mark.slow
 def test_folded_line_tracker_record():
     rec = Y.record(BENCH, np.random.default_rng(12), Y.Traits(amplitude=0.9, cycles=30, fold=True, white=0.004))
-    y, jumps = unfold(rec.y)
+    y, jumps = unfold(rec.y, rec.t)
     assert jumps > 0
     fit = fit_oscillation(rec.t, y, "angle", LAW)
     assert abs(fit.period - rec.period) < 3.0 * fit.period_std
@@ -264,7 +286,7 @@ def test_interval_coverage_on_records_with_every_trait():
     hits = 0
     for _ in range(12):
         rec = Y.record(ROD, rng, Y.video(rng, cycles=rng.uniform(12.0, 40.0)))
-        y = unfold(rec.y)[0]
+        y = unfold(rec.y, rec.t)[0]
         fit = fit_oscillation(rec.t, y, "angle", ROD_LAW)
         hits += abs(fit.period - rec.period) <= Z95 * fit.period_std
     low, _ = binom.interval(0.999, 12, 0.95)

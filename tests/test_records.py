@@ -78,6 +78,37 @@ def test_folded_angles_are_unfolded():
     assert jumps == 0 and same is theta
 
 
+def test_a_record_never_folded_is_left_as_it_is_whatever_its_big_steps():
+    # Issue 37 item 3: a 1.2 rad swing with a sway at twice its frequency, 60 fps, a run of 16 lost frames
+    # at full speed (a 2.6 rad step over the gap) and a tracker locking on (a jump of 2 rad): steps over
+    # pi/2, but no fold. Reducing them modulo pi put the pieces between them pi apart (refused records).
+    t = np.arange(1200) / 60.0
+    theta = 1.2 * np.cos(6.0 * t) + 0.25 * np.sin(12.0 * t)
+    keep = np.ones(len(t), dtype=bool)
+    keep[300:316] = False
+    t, theta = t[keep], theta[keep].copy()
+    theta[:5] = -0.25 * math.pi
+    assert np.abs(np.diff(theta)).max() > 0.5 * math.pi
+    same, jumps = R.unfold(theta, t)
+    assert jumps == 0 and same is theta
+
+
+def test_a_folded_record_is_unfolded_across_lost_frames():
+    # the folded line of test_folded_angles_are_unfolded swinging 1.2 rad, with runs of lost frames over
+    # which it turns by more than pi/2: each piece comes back by the multiple of pi that puts it on the swing
+    t = np.arange(1500) / 60.0
+    theta = 0.5 * math.pi + 1.2 * np.cos(6.0 * t) + 0.2 * np.sin(12.0 * t)
+    keep = np.ones(len(t), dtype=bool)
+    for start in (200, 455, 830, 1111):
+        keep[start:start + 20] = False
+    t, theta = t[keep], theta[keep]
+    folded = theta - math.pi * np.round(theta / math.pi)
+    out, jumps = R.unfold(folded, t)
+    assert jumps > 20
+    shift = math.pi * np.round((out[0] - theta[0]) / math.pi)
+    assert np.abs(out - shift - theta).max() < 1e-12
+
+
 GOOD = "".join(f"{0.05 * k},{math.cos(k / 3):.6f}\n" for k in range(30))
 
 

@@ -40,7 +40,7 @@ Z95 = 1.959963984540054
 def _record(rec: Y.Synthetic, name: str) -> Record:
     """The synthetic record as :func:`.read.read_record` would give it from a file: a folded line
     tracker's angle unfolded."""
-    y = unfold(rec.y)[0] if rec.traits.kind == "angle" else rec.y
+    y = unfold(rec.y, rec.t)[0] if rec.traits.kind == "angle" else rec.y
     return Record(name, "signal", rec.traits.kind, rec.t, y)
 
 

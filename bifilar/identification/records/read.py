@@ -96,25 +96,48 @@ def read_record(path: str | Path, column: str | None = None, kind: str = "angle"
         raise RigError(src, value, f"constant ({y[0]:g}) over the whole record: nothing oscillates")
     unfolded = 0
     if kind == "angle":
-        y, unfolded = unfold(y)
+        y, unfolded = unfold(y, t)
     return Record(src, value, kind, t, y, dropped, unfolded)
 
 
-def unfold(y: np.ndarray) -> tuple[np.ndarray, int]:
+def unfold(y: np.ndarray, t: np.ndarray | None = None) -> tuple[np.ndarray, int]:
     """A folded angle record made continuous, and the number of jumps removed.
 
     A line tracker reports angles in (-pi/2, pi/2]; where the body turns past +-pi/2 the record jumps
-    by ~pi between frames. If every sample lies in [-pi/2, pi/2] and some frame-to-frame step exceeds
-    pi/2 (the body cannot turn that far in one frame at any rate the fit can follow), steps are
-    reduced modulo pi. A single-frame glitch stays a single-frame glitch (its jump and its return
-    cancel), and a record that is not folded is returned as it is.
+    by ~pi between frames. A step between neighbouring frames (``t``: sample times, s; a gap is a step
+    over 1.5 median steps; without ``t`` every step is between neighbours) is a fold if it is within
+    pi/4 of +-pi: the body turns far less in one frame at any rate the fit can follow. The record is
+    folded if every sample lies in [-pi/2, pi/2] and at least two steps are folds, more than the steps
+    that are neither a fold nor small (between pi/4 and 3 pi/4: a tracker locking on, a glitch).
+    Otherwise it is returned as it is: a record that was never folded jumps by over pi/2 only where
+    frames were lost during a fast swing or the tracker locked on, and reducing those steps modulo pi
+    put pieces of it pi apart (a 1.2 rad swing with a sway at twice its frequency and runs of lost frames
+    was refused so).
+
+    A folded record is unfolded piece by piece: within a piece (neighbouring frames, no step between
+    pi/4 and 3 pi/4) each fold is removed; a gap or an unclear step starts a new piece, whose own
+    multiple of pi is the one that brings its median within pi/2 of the longest piece's median (the
+    swing's centre: pieces do not fold across a gap, where the body may turn by more than pi/2). A
+    single-frame glitch stays a single-frame glitch (its jump and its return cancel).
     """
     step = np.diff(y)
-    if np.abs(y).max() > 0.5 * _FOLD * (1.0 + 1e-9) or np.abs(step).max() <= 0.5 * _FOLD:
+    if len(step) == 0 or np.abs(y).max() > 0.5 * _FOLD * (1.0 + 1e-9):
         return y, 0
-    fixed = step - _FOLD * np.round(step / _FOLD)
-    jumps = int(np.count_nonzero(np.round(step / _FOLD)))
-    return np.concatenate([[y[0]], y[0] + np.cumsum(fixed)]), jumps
+    dt = np.diff(t) if t is not None else np.ones(len(step))
+    neighbours = dt <= 1.5 * np.median(dt)
+    folds = neighbours & (np.abs(np.abs(step) - _FOLD) < 0.25 * _FOLD)
+    unclear = ~neighbours | ((np.abs(step) > 0.25 * _FOLD) & ~folds)
+    if folds.sum() < 2 or folds.sum() <= (neighbours & unclear).sum():
+        return y, 0
+    fixed = np.where(unclear, step, step - _FOLD * np.round(step / _FOLD))
+    out = np.concatenate([[y[0]], y[0] + np.cumsum(fixed)])
+    starts = np.concatenate([[0], np.flatnonzero(unclear) + 1, [len(y)]])
+    pieces = [(a, b) for a, b in zip(starts[:-1], starts[1:]) if b > a]
+    a, b = max(pieces, key=lambda p: p[1] - p[0])
+    centre = float(np.median(out[a:b]))
+    for a, b in pieces:
+        out[a:b] += _FOLD * np.round((centre - float(np.median(out[a:b]))) / _FOLD)
+    return out, int(folds.sum())
 
 
 def _table(path) -> tuple[list[str], list[tuple[int, list[str]]], int]:
