@@ -287,7 +287,7 @@ def print_trial(i: int, tr: dict, key: str = "inertia", symbol: str = "I", unit:
         say(f"T0 sigma (record) {tr['period_std_statistical']:.2g} s = {tr['crb_ratio']:.2f}x the Cramér-Rao bound "
             f"{tr['crb']:.2g} s ({tr['crb_noise']} noise)", 4)
     amp, d = tr["amplitude"], tr["damping"]
-    swing = f"{amp[0]:.3g} -> {amp[1]:.3g} rad" if amp else "swing in rad unknown (proportional)"
+    swing = f"{amp[0]:.3g} -> {amp[1]:.3g} rad" if amp else "in rad unknown (proportional)"
     second = tr["second_mode"]
     say(f"swing {swing} over {tr['cycles']} cycles; damping {d['linear']:.2g} + {d['quadratic']:.2g} |w| + dry "
          f"{d['dry']:.2g}; rms {tr['residual_rms']:.3g}" + (f"; second mode {second['period']:.4g} s" if second else ""),
