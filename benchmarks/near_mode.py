@@ -10,7 +10,10 @@ Measured (seed 7, 30 records, before issue 37 item 1's change): rms z 2.41; ever
 sway at 0.96-0.99 omega0 (under 1 beat over the record, inside the swept band) with sigma ~3e-4 and
 an error of 1-3e-3; many others a sigma of ~1e-2 (the white-noise one ~5e-6), the law having taken
 the beat for an amplitude-dependent frequency (a 0.96 omega0 sway asked for ds = 0.20, 2.8 s, 8 prior sigmas:
-the law conflict, whose sigma holds the T0s of both laws).
+the law conflict, whose sigma holds the T0s of both laws). With the envelope's rise held against the
+learned law (:func:`bifilar.identification.records.near.envelope_rises`, :meth:`...phase_law.Model.check_law`):
+rms z 1.43; left with |z| > 2.5, 4 records whose sway at 0.97-0.99 omega0 makes half a beat or less (z -2.7
+to -3.8): there the envelope only falls faster, and the law learns the beat within its prior.
 """
 
 import math
