@@ -20,6 +20,14 @@ plausible ones (a profile over omega2); omega0's linearised shift over them is a
 Jacobian (at the best omega2 only) may not carry where the beat is not resolved (less than one beat
 over the record: the sinusoid and the first mode's frequency trade off nonlinearly). :func:`profile_sigma`
 gives it, as half that range over 1.96.
+
+To first order in its size a beat is the same as an amplitude law whose frequency moves with ln A at
+the beat frequency, and the law the record learns takes it within its prior where it makes less than
+a beat over the record. What tells it apart is that damping only shrinks the swing: where the cycles'
+envelope rises again (:func:`envelope_rises`), :meth:`.phase_law.Model.check_law` holds T0 under the
+ideal law in the sigma as well, as it does for a law past its prior. (:func:`scan` is not yet used by
+the record fit: searched on the whole fit's residual it finds the beat's mirror image, the law having
+taken the beat; issue 37 item 1 is open.)
 """
 
 from __future__ import annotations

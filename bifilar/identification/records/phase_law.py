@@ -73,6 +73,7 @@ class Model:
         self.order_shift = 0.0  # omega0 learned less omega0 with one excess term fewer (rad/s)
         self.conflict = 0.0  # the largest excess of the last fit, in prior sigmas
         self.held_shift = 0.0  # omega0 learned less omega0 under the ideal law (rad/s), past LAW_CONFLICT
+        self.rises = False  # the cycles' envelope rises again (.near.envelope_rises): a mode beating in
         self.harmonic = None  # a proportional record's scale from its third harmonic (:func:`harmonic_scale`)
 
     def _table(self, omega: float, largest: float) -> Table:
@@ -330,7 +331,8 @@ class Model:
             fewer._solve(cyc, cyc.good & np.isfinite(cyc.phase))
             self.order_shift = self.omega0 - fewer.omega0
         good = cyc.good & np.isfinite(cyc.phase)
-        if self.conflict <= LAW_CONFLICT and not envelope_rises(cyc.centre[good], cyc.fundamental[good]):
+        self.rises = "ds" in self.names and envelope_rises(cyc.centre[good], cyc.fundamental[good])
+        if self.conflict <= LAW_CONFLICT and not self.rises:
             return
         held = copy.copy(self)
         held.held = True
