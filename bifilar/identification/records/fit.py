@@ -34,7 +34,8 @@ and assembles the result; each step is a module of its own.
    many frames, a wandering offset, a left-over beat all make neighbouring cycles err together), never
    below the white-noise covariance, plus what the envelope's own uncertainty adds (Murphy-Topel); the
    prior rows add the law's doubt, reported apart (``period_std_law``), with the learned law's own
-   doubts (:meth:`.phase_law.Model.check_law`: its extrapolation to zero swing, a law no rig has). A
+   doubts (:meth:`.phase_law.Model.check_law`: its extrapolation to zero swing, a law no rig has or an
+   envelope that rises again, a mode near the torsion's frequency beating in: :mod:`.near`). A
    delete-a-group jackknife of the law's fit over 20 groups of cycles checks it
    (:meth:`.phase_law.Model.jackknife`): where its variance is above the covariance's at 95 %, the
    jackknife's (Student-t scaled) is the statistical variance.
@@ -92,6 +93,7 @@ class Law:
     learned: float
     note: str = ""
     conflict: float | None = None  # past LAW_CONFLICT: the excess the record asked for, in prior sigmas
+    beat: bool = False  # the envelope rises again (.near.envelope_rises): the ideal law's T0 is in the sigma
 
     @property
     def coefficient(self) -> float | None:
@@ -100,7 +102,7 @@ class Law:
     def as_dict(self) -> dict:
         return {"kind": self.kind, "ideal": self.ideal, "coefficient": self.coefficient, "excess": self.excess,
                 "excess_std": self.excess_std, "excess_quartic": self.quartic, "excess_quartic_std": self.quartic_std,
-                "learned": self.learned, "note": self.note, "conflict": self.conflict}
+                "learned": self.learned, "note": self.note, "conflict": self.conflict, "beat": self.beat}
 
 
 @dataclass(frozen=True)
@@ -310,7 +312,7 @@ def _result(rec: Samples, t: np.ndarray, cyc: Cycles, model: Model, baseline: np
     law = Law("none (scale unknown)" if note else model.law.kind,
               model.ideal, float(excess), float(std[names.index("ds")]) if "ds" in names else 0.0,
               float(quartic), float(std[names.index("dq")]) if "dq" in names else 0.0, float(learned), note,
-              model.conflict if model.conflict > LAW_CONFLICT else None)
+              model.conflict if model.conflict > LAW_CONFLICT else None, model.rises)
     curve = _law_curve(model, period, cycle_amp)
     level = cyc.offset[good] + np.interp(centre, rec.tau, baseline)  # the offset under each cycle
     amplitude = None

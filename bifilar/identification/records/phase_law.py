@@ -24,6 +24,7 @@ import numpy as np
 from .cycles import Cycles
 from .damping import damping_of, damping_shift
 from .law import AmplitudeLaw, Table
+from .near import envelope_rises
 from .read import MIN_CYCLES
 from .spread import sandwich, white_and_blocks
 
@@ -72,6 +73,7 @@ class Model:
         self.order_shift = 0.0  # omega0 learned less omega0 with one excess term fewer (rad/s)
         self.conflict = 0.0  # the largest excess of the last fit, in prior sigmas
         self.held_shift = 0.0  # omega0 learned less omega0 under the ideal law (rad/s), past LAW_CONFLICT
+        self.rises = False  # the cycles' envelope rises again (.near.envelope_rises): a mode beating in
         self.harmonic = None  # a proportional record's scale from its third harmonic (:func:`harmonic_scale`)
 
     def _table(self, omega: float, largest: float) -> Table:
@@ -313,7 +315,8 @@ class Model:
         is more than the sigma already holds), each the same cycles refitted: :attr:`order_shift`,
         omega0 as fitted less omega0 with the excess's last term held at zero, and past
         :data:`LAW_CONFLICT` :attr:`held_shift`, omega0 less omega0 with the whole excess held at the
-        ideal law.
+        ideal law; the same where the cycles' envelope rises (:func:`.near.envelope_rises`: a mode
+        beating in, which the law learns as a frequency moving with the swing, within its prior).
 
         The first is the extrapolation's: a record whose swing spans a narrow range (a lightly damped
         rig from 1.2 rad to 1.05) gives the law's value, slope and curvature there so precisely that
@@ -327,7 +330,9 @@ class Model:
             fewer.terms = len(EXCESS_TERMS) - 1
             fewer._solve(cyc, cyc.good & np.isfinite(cyc.phase))
             self.order_shift = self.omega0 - fewer.omega0
-        if self.conflict <= LAW_CONFLICT:
+        good = cyc.good & np.isfinite(cyc.phase)
+        self.rises = "ds" in self.names and envelope_rises(cyc.centre[good], cyc.fundamental[good])
+        if self.conflict <= LAW_CONFLICT and not self.rises:
             return
         held = copy.copy(self)
         held.held = True
