@@ -72,6 +72,12 @@ _STEPS = 256  # RK4 steps per undamped period (2 pi)
 
 
 @nb.njit(cache=True)
+def _acceleration(th, v, zeta, quad, dry, eps):
+    """theta'' of :func:`_cycle_from`'s oscillator (time in radians of the undamped period)."""
+    return -th - 2.0 * zeta * v - quad * abs(v) * v - dry * math.tanh(v / eps)
+
+
+@nb.njit(cache=True)
 def _cycle_from(a, zeta, quad, dry, eps):
     """(first, second descending crossing, trough between) of theta'' + theta = -2 zeta theta' -
     c |theta'| theta' - m tanh(theta' / eps) released at rest from ``a``: :func:`damping_shift`'s RK4 at
@@ -79,15 +85,15 @@ def _cycle_from(a, zeta, quad, dry, eps):
     none came), the trough the deepest step between the crossings."""
     h = 2.0 * math.pi / _STEPS
     th, v = a, 0.0
-    first, second, trough = np.nan, np.nan, 0.0
+    first, trough = np.nan, 0.0
     for n in range(3 * _STEPS):
-        k1x, k1v = v, -th - 2.0 * zeta * v - quad * abs(v) * v - dry * math.tanh(v / eps)
-        t2, v2 = th + 0.5 * h * k1x, v + 0.5 * h * k1v
-        k2x, k2v = v2, -t2 - 2.0 * zeta * v2 - quad * abs(v2) * v2 - dry * math.tanh(v2 / eps)
-        t3, v3 = th + 0.5 * h * k2x, v + 0.5 * h * k2v
-        k3x, k3v = v3, -t3 - 2.0 * zeta * v3 - quad * abs(v3) * v3 - dry * math.tanh(v3 / eps)
-        t4, v4 = th + h * k3x, v + h * k3v
-        k4x, k4v = v4, -t4 - 2.0 * zeta * v4 - quad * abs(v4) * v4 - dry * math.tanh(v4 / eps)
+        k1x, k1v = v, _acceleration(th, v, zeta, quad, dry, eps)
+        k2x = v + 0.5 * h * k1v
+        k2v = _acceleration(th + 0.5 * h * k1x, k2x, zeta, quad, dry, eps)
+        k3x = v + 0.5 * h * k2v
+        k3v = _acceleration(th + 0.5 * h * k2x, k3x, zeta, quad, dry, eps)
+        k4x = v + h * k3v
+        k4v = _acceleration(th + h * k3x, k4x, zeta, quad, dry, eps)
         new = th + h / 6.0 * (k1x + 2 * k2x + 2 * k3x + k4x)
         new_v = v + h / 6.0 * (k1v + 2 * k2v + 2 * k3v + k4v)
         if th > 0.0 and new <= 0.0:
@@ -99,4 +105,4 @@ def _cycle_from(a, zeta, quad, dry, eps):
         elif not np.isnan(first):
             trough = max(trough, -new)
         th, v = new, new_v
-    return first, second, trough
+    return first, np.nan, trough

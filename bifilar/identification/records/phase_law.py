@@ -263,16 +263,11 @@ class Model:
         self.peak_at = (lambda tt: np.interp(tt, grid, a_fit)) if law_on else (lambda tt: None)
         self.rate_at = lambda tt: np.interp(tt, grid, g_fit)
         self.decay_at = lambda tt: np.interp(tt, grid, slope)
-        cum = np.concatenate([[0.0], np.cumsum(0.5 * (g_fit[1:] + g_fit[:-1]) * np.diff(grid))])
-        cum = cum - float(np.interp(at_ref, np.arange(len(grid)), cum))
+        cum = _from_reference(grid, g_fit, at_ref)
         self.phase_integral = (grid, cum, float(p[0]), float(p[1]), float(g_fit[0]), float(g_fit[-1]))
         # the integral's response to each law parameter (names[2:]) and their priors' sds, for the
         # Cramér-Rao bound of a whole fit with the law free (:mod:`.bound`)
-        self.law_slopes = []
-        for d in terms(p)[3]:
-            dcum = np.concatenate([[0.0], np.cumsum(0.5 * (d[1:] + d[:-1]) * np.diff(grid))])
-            self.law_slopes.append((grid, dcum - float(np.interp(at_ref, np.arange(len(grid)), dcum)),
-                                    float(d[0]), float(d[-1])))
+        self.law_slopes = [(grid, _from_reference(grid, d, at_ref), float(d[0]), float(d[-1])) for d in terms(p)[3]]
         self.law_prior_sd = np.array([sd for _, _, sd in sorted(priors)])
         self._covariance(j_phase, jp, r_phase, j_envelope, envelope.cov)
 
@@ -325,18 +320,18 @@ class Model:
         noise); with one term fewer, where the record does determine the law, the two agree to a
         fraction of their sigma."""
         self.held_shift = self.order_shift = 0.0
+        good = cyc.good & np.isfinite(cyc.phase)
         if "ds" in self.names and not self.held:
             fewer = copy.copy(self)  # _solve rebinds its results: the shallow copy keeps this fit's
             fewer.terms = len(EXCESS_TERMS) - 1
-            fewer._solve(cyc, cyc.good & np.isfinite(cyc.phase))
+            fewer._solve(cyc, good)
             self.order_shift = self.omega0 - fewer.omega0
-        good = cyc.good & np.isfinite(cyc.phase)
         self.rises = "ds" in self.names and envelope_rises(cyc.centre[good], cyc.fundamental[good])
         if self.conflict <= LAW_CONFLICT and not self.rises:
             return
         held = copy.copy(self)
         held.held = True
-        held._solve(cyc, cyc.good & np.isfinite(cyc.phase))
+        held._solve(cyc, good)
         self.held_shift = self.omega0 - held.omega0
 
     def integral_at(self, tt: np.ndarray) -> np.ndarray:
@@ -510,6 +505,12 @@ def harmonic_scale(amp: np.ndarray, third: np.ndarray, third_var: np.ndarray) ->
         return q, sd, lead > 0.0
     top = max(max(q, 0.0) + 2.0 * sd for q, sd in (solve(True), solve(False)))
     return 0.5 * top, top / math.sqrt(12.0), lead > 0.0
+
+
+def _from_reference(grid: np.ndarray, rate: np.ndarray, at_ref: float) -> np.ndarray:
+    """The trapezoidal integral of ``rate`` over ``grid``, zero at grid index ``at_ref`` (fractional)."""
+    cum = np.concatenate([[0.0], np.cumsum(0.5 * (rate[1:] + rate[:-1]) * np.diff(grid))])
+    return cum - float(np.interp(at_ref, np.arange(len(grid)), cum))
 
 
 def _carried(tt, grid, cum, g0, g1):
