@@ -40,7 +40,7 @@ from .measurement import said_once, start_moment
 from .identify import AMPLITUDE_PASSES, AMPLITUDE_RTOL, amplitude_ratio, invert_period
 from .records.law import EXCESS_PRIOR
 from .records.pipeline import RecordOptions, identify_records
-from .tensor import Hanging, Tare, Tensor, identify_tensor, tensor_of
+from .tensor import Hanging, Tare, Tensor, identify_tensor, moment_row, tensor_of
 from .transfer import parallel_axis
 
 _RECORD_KEYS = {"column", "kind", "time_column", "fps", "time_unit", "angle_unit", "from", "to", "law_sigma",
@@ -519,8 +519,7 @@ def _start_from_periods(entries: list[_Entry], held: list[np.ndarray], measured:
         rig = _hung(e, h, _PLACEHOLDER * mass * np.eye(3))
         vertical = _vertical(rig)
         j = invert_period(rig, vertical, m.period).moment - float(vertical @ h @ vertical)
-        n = e.orientation.T @ vertical
-        rows.append([n[0] ** 2, n[1] ** 2, n[2] ** 2, 2 * n[0] * n[1], 2 * n[1] * n[2], 2 * n[0] * n[2]])
+        rows.append(moment_row(e.orientation.T @ vertical))
         moments.append(j)
     x = tensor_of(np.linalg.lstsq(np.array(rows), np.array(moments), rcond=None)[0])
     if np.linalg.eigvalsh(x)[0] > 0.0:

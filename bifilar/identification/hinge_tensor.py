@@ -52,7 +52,7 @@ from bifilar.rig.ranges import RANGES
 from .hangings import PERIOD_RANGE, Measured, orientation, period_sigma
 from .hinge import moment_from_period, stiffness_from_period
 from .plan import Candidate
-from .tensor import COMPONENTS, Tensor, tensor_of
+from .tensor import COMPONENTS, Tensor, moment_row, tensor_of
 
 __all__ = ["HingeHanging", "HingeSetup", "Rod", "fit_hinge_hangings", "hinge_candidates", "hinge_file",
            "identify_hinge_tensor", "read_hinge_hangings", "row"]
@@ -60,7 +60,6 @@ __all__ = ["HingeHanging", "HingeSetup", "Rod", "fit_hinge_hangings", "hinge_can
 _KEYS = {"hanging", "name", "rod", "known"}
 _HANGING_KEYS = {"rig", "orientation", "period", "period_std", "amplitude", "name"}
 _ROD_KEYS = {"stiffness", "stiffness_std", "calibration", "period", "period_std", "amplitude"}
-_PAIRS = ((0, 0), (1, 1), (2, 2), (0, 1), (1, 2), (0, 2))
 _RANK_RTOL = 1e-8  # singular values of the (dimensionless) rows below this fraction: undetermined
 _SAME_MASS = 1e-3  # relative: rig files whose masses differ by more are not the same part
 _SAME_COM = 1e-3  # x the pivots' largest arm: COMs (object axes) further apart are not the same part's
@@ -99,8 +98,7 @@ class HingeHanging:
 
 def row(axis: np.ndarray, q: np.ndarray) -> np.ndarray:
     """a with a . x = u^T X u, u = Q^T ``axis`` (rig body frame -> object frame); products count twice."""
-    u = np.asarray(q, float).T @ axis
-    return np.array([(1.0 if i == k else 2.0) * u[i] * u[k] for i, k in _PAIRS])
+    return moment_row(np.asarray(q, float).T @ axis)
 
 
 def identify_hinge_tensor(hangings: list[HingeHanging], rod: Rod | None = None, known: dict | None = None,

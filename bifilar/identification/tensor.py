@@ -106,13 +106,19 @@ class Tensor:
         moments, axes = np.linalg.eigh(self.inertia)
         if self.covariance is None:
             return moments, axes, None
-        g = np.array([[(1.0 if a == b else 2.0) * u[a] * u[b] for a, b in _PAIRS] for u in axes.T])
+        g = np.array([moment_row(u) for u in axes.T])
         return moments, axes, np.sqrt(np.einsum("ki,ij,kj->k", g, self.covariance, g))
 
 
 def tensor_of(x: np.ndarray) -> np.ndarray:
     """The symmetric 3x3 tensor of the six components (COMPONENTS order)."""
     return np.array([[x[0], x[3], x[5]], [x[3], x[1], x[4]], [x[5], x[4], x[2]]])
+
+
+def moment_row(u: np.ndarray) -> np.ndarray:
+    """a with a . x = u^T X u for the six components x of X (COMPONENTS order; products count twice):
+    the moment about ``u`` (a unit vector, object axes) is linear in the components."""
+    return np.array([(1.0 if a == b else 2.0) * u[a] * u[b] for a, b in _PAIRS])
 
 
 def components_of(t: np.ndarray) -> np.ndarray:
@@ -179,7 +185,7 @@ class Linear:
         """(T, d T / d components) of the yaw at components ``x``."""
         t, v = self.solve(x)
         shape = self.arm.T @ v  # object frame
-        grad = np.array([(1.0 if a == b else 2.0) * shape[a] * shape[b] for a, b in _PAIRS]) * 0.5 * t
+        grad = moment_row(shape) * 0.5 * t
         return t, grad
 
     def held_slope(self, x: np.ndarray, axis: np.ndarray) -> float:
