@@ -4,7 +4,7 @@ kernels that compile only when they loop.
 The Kane, TMT and signal kernels are compiled by numba with ``cache=True``. Left to itself numba writes
 its cache into ``__pycache__`` beside the sources (which fails silently in a read-only install, and
 litters a checkout); :func:`use_user_cache` points it at the user's cache folder instead (one
-subfolder per state of the kernels' sources: :func:`kernels_key`), unless ``NUMBA_CACHE_DIR`` is already set, and compiles at LLVM's level 2 (:data:`OPT_LEVEL`). The first run
+subfolder per state of the kernels' sources: :func:`kernels_key`), unless ``NUMBA_CACHE_DIR`` is already set, and compiles at LLVM's level 1 (:data:`OPT_LEVEL`). The first run
 after an install or a change of a kernel compiles for 30-80 s; :func:`announce_compile` says so in one
 line instead of leaving the user in silence, and the suite runs the cases that compile first, one
 worker each (:data:`validate.registry.COMPILES`).
@@ -49,8 +49,13 @@ def kernels_key(root: Path = Path(__file__).parent) -> str:
 
 # LLVM's optimisation level for the kernels. numba's default, 3, compiled the suite's kernels in 153 s
 # on 2 busy cores, 2 in 99 s, with the kernels as fast (benchmarks/kane.py, benchmarks/sweep.py side by
-# side: rhs evaluations and sweep configurations per second within their run-to-run scatter).
-OPT_LEVEL = "2"
+# side: rhs evaluations and sweep configurations per second within their run-to-run scatter). Level 1
+# compiles boat-study's kernels (Kane, pose, slopes, sweep) in 60 s of CPU against 72 s at level 2 (two
+# runs each, empty caches, /usr/bin/time), `validate all` cold in 78 s against 101 s at level 3; the
+# Kane rhs runs 3-5 % slower (benchmarks/kane.py: 2.33-2.40e5 against 2.41-2.50e5 evaluations/s, two
+# interleaved rounds) and the sweep as fast (1.82-1.85e3 configurations/s/core against 1.83-1.86e3). A
+# first run compiles every kernel; the warm ones spend most of their time in MuJoCo and scipy.
+OPT_LEVEL = "1"
 
 
 def use_user_cache() -> None:
