@@ -385,10 +385,10 @@ def _quiet_warnings():
 
 
 def _check_warnings(data: mujoco.MjData, t: float) -> None:
-    for i in range(mujoco.mjtWarning.mjNWARNING):
-        if data.warning[i].number:
-            name = mujoco.mjtWarning(i).name
-            raise IntegrationError(f"mujoco: {name} by t = {t:g} s; the run is not valid (numerics too coarse?)")
+    counts = data.warning.number  # one count per mjtWarning, read at once (called at every sample)
+    if counts.any():
+        name = mujoco.mjtWarning(int(np.flatnonzero(counts)[0])).name
+        raise IntegrationError(f"mujoco: {name} by t = {t:g} s; the run is not valid (numerics too coarse?)")
 
 
 ENGINES = {
