@@ -1,10 +1,12 @@
 """A mode beating in near the first one's frequency lifts the envelope (bifilar.identification.records.near): decaying envelopes do not."""
 
 import math
+from types import SimpleNamespace
 
 import numpy as np
 
 from bifilar.identification.records.near import envelope_rises
+from bifilar.identification.records.pipeline import _own_variances
 
 
 def _envelope(rng, share, ratio, cycles=25, zeta=5e-4, noise=2e-3):
@@ -26,3 +28,29 @@ def test_a_beat_under_one_cycle_lifts_the_envelope():
     # ~10 % against a decay of 7.6 % (zeta 5e-4) and a noise of 0.2 % a cycle
     rng = np.random.default_rng(41)
     assert envelope_rises(*_envelope(rng, 0.05, 0.96))
+
+
+def _fit(excess, excess_std, gap, own=1e-4):
+    """A stand-in for a fit (what bifilar.identification.records.pipeline._own_variances reads): T0's
+    own sigma ``own`` (s, no prior part), the excess learned with its sigma, T0 under the ideal law less
+    T0 learned (``gap``, s)."""
+    law = SimpleNamespace(excess=excess, excess_std=excess_std, ideal_gap=gap, conflict=None, beat=False)
+    return SimpleNamespace(law=law, period_std=own, period_std_statistical=own, prior_gain=np.zeros(3))
+
+
+def test_trials_whose_laws_agree_keep_their_own_variances():
+    # six trials of one rig learning ds = 0.02 +- 0.005 within 1.2 sigma of each other (chi^2 2.3 on 5
+    # dof, under the 99 % quantile 15.1): the law they learned is the rig's, their gaps to the ideal law
+    # (3e-3 s, 30 sigmas) are that law's effect, not a doubt
+    fits = [_fit(0.02 + 0.005 * d, 0.005, 3e-3) for d in (-1.2, -0.4, 0.0, 0.3, 0.5, 0.6)]
+    assert np.allclose(_own_variances(fits), 1e-8, rtol=1e-12)
+
+
+def test_trials_whose_laws_disagree_hold_the_ideal_law_s_periods():
+    # a sway beating in, its phase and size new each trial, makes each learn its own law: ds 0.002 to
+    # 0.030 +- 0.005 (benchmarks/near_mode.py's misses learned 0.007-0.024 +- 0.005-0.008; chi^2 27 on 5
+    # dof, past the 99 % quantile 15.1): each trial's T0 under the ideal law enters its variance
+    ds = np.array([0.002, 0.030, 0.016, 0.024, 0.006, 0.028])
+    gaps = 0.09 * ds  # the excess's effect on T0 at 0.3 rad: ds A^2 (relative, T0 ~ 1 s)
+    fits = [_fit(d, 0.005, g) for d, g in zip(ds, gaps)]
+    assert np.allclose(_own_variances(fits), 1e-8 + gaps**2, rtol=1e-12)
