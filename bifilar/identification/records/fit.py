@@ -94,6 +94,7 @@ class Law:
     note: str = ""
     conflict: float | None = None  # past LAW_CONFLICT: the excess the record asked for, in prior sigmas
     beat: bool = False  # the envelope rises again (.near.envelope_rises): the ideal law's T0 is in the sigma
+    ideal_gap: float = 0.0  # s, T0 under the ideal law (the excess held at zero) less T0 learned
 
     @property
     def coefficient(self) -> float | None:
@@ -312,7 +313,7 @@ def _result(rec: Samples, t: np.ndarray, cyc: Cycles, model: Model, baseline: np
     law = Law("none (scale unknown)" if note else model.law.kind,
               model.ideal, float(excess), float(std[names.index("ds")]) if "ds" in names else 0.0,
               float(quartic), float(std[names.index("dq")]) if "dq" in names else 0.0, float(learned), note,
-              model.conflict if model.conflict > LAW_CONFLICT else None, model.rises)
+              model.conflict if model.conflict > LAW_CONFLICT else None, model.rises, to_period * model.ideal_shift)
     curve = _law_curve(model, period, cycle_amp)
     level = cyc.offset[good] + np.interp(centre, rec.tau, baseline)  # the offset under each cycle
     amplitude = None

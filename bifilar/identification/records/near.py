@@ -14,8 +14,16 @@ sigma as well, as it does for a law past its prior.
 Searching the whole fit's residual for the near mode (a sinusoid at each trial omega2, the rest of the
 model linearised, a look-elsewhere threshold) was tried and left out: with the learned law having taken
 the beat, the residual showed the beat's mirror image (a sway at 0.963 omega0 turned up at 1.035) and
-joint fits wandered (rms z 3.24 against 1.43 without it, ``benchmarks/near_mode.py``). Half a beat or
-less over the record stays open (issue 37 item 1).
+joint fits wandered (rms z 3.24 against 1.43 without it, ``benchmarks/near_mode.py``).
+
+Half a beat or less over one record cannot be told from a law at all: while the beat's phase
+dw t + phi sweeps less than pi, the envelope's share of it moves one way, and the frequency the beat
+adds, d arg(1 + eps e^(i (dw t + phi))) / dt, is a single-valued function of it, to every order in
+eps, so it is an amplitude law (in the beat's part of ln A; the damping moves ln A alone). What does tell it apart is
+that a rig has one law: records of it, or a record's two halves, each learn the beat their own
+sway's phase and size ask for. Where the excesses they learned disagree beyond their sigmas,
+:func:`.pipeline._own_variances` holds each one's T0 under the ideal law in its variance (the
+pooled trials' chi^2 and the halves' test). One record alone stays open (issue 37 item 1).
 """
 
 from __future__ import annotations

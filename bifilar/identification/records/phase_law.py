@@ -73,6 +73,7 @@ class Model:
         self.order_shift = 0.0  # omega0 learned less omega0 with one excess term fewer (rad/s)
         self.conflict = 0.0  # the largest excess of the last fit, in prior sigmas
         self.held_shift = 0.0  # omega0 learned less omega0 under the ideal law (rad/s), past LAW_CONFLICT
+        self.ideal_shift = 0.0  # the same, whatever the conflict: what a law shared with other records weighs
         self.rises = False  # the cycles' envelope rises again (.near.envelope_rises): a mode beating in
         self.harmonic = None  # a proportional record's scale from its third harmonic (:func:`harmonic_scale`)
 
@@ -312,6 +313,8 @@ class Model:
         :data:`LAW_CONFLICT` :attr:`held_shift`, omega0 less omega0 with the whole excess held at the
         ideal law; the same where the cycles' envelope rises (:func:`.near.envelope_rises`: a mode
         beating in, which the law learns as a frequency moving with the swing, within its prior).
+        That difference is kept whatever the conflict (:attr:`ideal_shift`): fits of one rig whose
+        learned laws disagree hold it (:func:`.pipeline._own_variances`).
 
         The first is the extrapolation's: a record whose swing spans a narrow range (a lightly damped
         rig from 1.2 rad to 1.05) gives the law's value, slope and curvature there so precisely that
@@ -319,7 +322,7 @@ class Model:
         the law's shape into 1.5e-3 of T0 (6-8 sigma of the covariance's, which only counts the
         noise); with one term fewer, where the record does determine the law, the two agree to a
         fraction of their sigma."""
-        self.held_shift = self.order_shift = 0.0
+        self.held_shift = self.order_shift = self.ideal_shift = 0.0
         good = cyc.good & np.isfinite(cyc.phase)
         if "ds" in self.names and not self.held:
             fewer = copy.copy(self)  # _solve rebinds its results: the shallow copy keeps this fit's
@@ -327,12 +330,14 @@ class Model:
             fewer._solve(cyc, good)
             self.order_shift = self.omega0 - fewer.omega0
         self.rises = "ds" in self.names and envelope_rises(cyc.centre[good], cyc.fundamental[good])
-        if self.conflict <= LAW_CONFLICT and not self.rises:
+        if "ds" not in self.names or self.held:
             return
         held = copy.copy(self)
         held.held = True
         held._solve(cyc, good)
-        self.held_shift = self.omega0 - held.omega0
+        self.ideal_shift = self.omega0 - held.omega0
+        if self.conflict > LAW_CONFLICT or self.rises:
+            self.held_shift = self.ideal_shift
 
     def integral_at(self, tt: np.ndarray) -> np.ndarray:
         """int dt / (R E D) from the reference time to ``tt`` (s), carried on at the end rates beyond the

@@ -286,7 +286,7 @@ def halves(record: Record, law: AmplitudeLaw, options: RecordOptions,
             return None
     a, b = fits
     common = a.prior_gain - b.prior_gain  # the law's prior moves both: only its difference separates them
-    var = _independent(a) + _independent(b) + float(common @ common)
+    var = float(np.sum(_own_variances(fits))) + float(common @ common)
     return Halves((a.period, a.period_std), (b.period, b.period_std), float(split),
                   float((a.period - b.period) / math.sqrt(var)))
 
@@ -294,6 +294,27 @@ def halves(record: Record, law: AmplitudeLaw, options: RecordOptions,
 def _independent(fit: OscillationFit) -> float:
     """The variance of T0 that is this record's own: all but the law's prior part."""
     return max(fit.period_std**2 - float(fit.prior_gain @ fit.prior_gain), fit.period_std_statistical**2)
+
+
+def _own_variances(fits: list[OscillationFit]) -> np.ndarray:
+    """Each fit's own variance of T0 (:func:`_independent`), of fits of one rig (trials, or a record's
+    halves), which share its amplitude law. Where the excesses they learned disagree (their chi^2 about
+    the weighted mean past the :data:`CONSISTENCY` quantile), what each learned is not that one law: a
+    mode near the torsion's frequency, less than a beat over a record, is to first order a law moving
+    the frequency with ln A, and each record's sway (its phase and size new each time) asks for its own
+    (:mod:`.near`). Each fit's T0 under the ideal law is then in its variance too (``law.ideal_gap``),
+    as :meth:`.phase_law.Model.check_law` holds it for a law no rig has (and then already has there)."""
+    own = np.array([_independent(f) for f in fits])
+    learned = [f for f in fits if f.law.excess_std > 0.0]
+    if len(learned) < 2:
+        return own
+    ds = np.array([f.law.excess for f in learned])
+    w = 1.0 / np.array([f.law.excess_std for f in learned]) ** 2
+    spread = float(np.sum(w * (ds - np.sum(w * ds) / np.sum(w)) ** 2))
+    if spread <= chi2.ppf(CONSISTENCY, len(learned) - 1):
+        return own
+    held = [f.law.conflict is not None or f.law.beat for f in fits]
+    return own + np.array([0.0 if h else f.law.ideal_gap for f, h in zip(fits, held)]) ** 2
 
 
 def file_name(record: Record) -> str:
