@@ -60,10 +60,12 @@ def left_out(markexpr: str) -> set[str]:
 
 def pytest_collection_modifyitems(config, items):
     tiers = left_out(config.getoption("markexpr"))
-    dropped = [item for item in items if any(item.get_closest_marker(t) for t in tiers)]
+    kept, dropped = [], []
+    for item in items:
+        (dropped if any(item.get_closest_marker(t) for t in tiers) else kept).append(item)
     if dropped:
         config.hook.pytest_deselected(items=dropped)
-        items[:] = [item for item in items if item not in set(dropped)]
+        items[:] = kept
 
 
 @pytest.fixture(params=["plate", "parallel", "asymmetric", "sidesway"])

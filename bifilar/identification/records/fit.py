@@ -119,7 +119,8 @@ class OscillationFit:
     cycle (None where the scale is unknown). ``cycle_*``: the measured cycles. ``jackknife``: the groups
     of cycles of the jackknife that set the statistical sigma (0: the covariance held;
     :meth:`.phase_law.Model.jackknife`). ``crb``: the Cramér-Rao bound's sigma of T0 (s) for the whole
-    fit's model (the law's shape held) and the noise its residual shows, judged ``crb_noise`` ('white'
+    fit's model with the law's parameters free under their priors (the record's part) and the noise its
+    residual shows, judged ``crb_noise`` ('white'
     or 'coloured'; :mod:`.bound`): ``period_std_statistical / crb`` is how far the fit is from efficient.
     """
 

@@ -297,8 +297,8 @@ def _independent(fit: OscillationFit) -> float:
 
 
 def _own_variances(fits: list[OscillationFit]) -> np.ndarray:
-    """Each fit's own variance of T0 (:func:`_independent`), of fits of one rig (trials, or a record's
-    halves), which share its amplitude law. Where the excesses they learned disagree (their chi^2 about
+    """Each fit's own variance of T0 (:func:`_independent`), of fits of one rig (a record's halves, in
+    :func:`halves`), which share its amplitude law. Where the excesses they learned disagree (their chi^2 about
     the weighted mean past the :data:`CONSISTENCY` quantile), what each learned is not that one law: a
     mode near the torsion's frequency, less than a beat over a record, is to first order a law moving
     the frequency with ln A, and each record's sway (its phase and size new each time) asks for its own
