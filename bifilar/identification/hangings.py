@@ -37,7 +37,7 @@ from bifilar.rig.ranges import MAX_PERIOD_SIGMA, MAX_RELATIVE_SIGMA, rig_size
 from bifilar.rig.statics import rest_pose
 
 from .measurement import said_once, start_moment
-from .identify import AMPLITUDE_PASSES, AMPLITUDE_RTOL, amplitude_ratio, invert_period
+from .identify import AMPLITUDE_PASSES, amplitude_ratio, invert_period, settled
 from .records.law import EXCESS_PRIOR
 from .records.pipeline import RecordOptions, identify_records
 from .tensor import Hanging, Tare, Tensor, identify_tensor, moment_row, tensor_of
@@ -153,17 +153,19 @@ def _hangings(entries: list[_Entry], held: list[np.ndarray], measured: list[Meas
 def _amplitude_fixed_point(entries, held, measured, hangings, x, tares, tare_of, src):
     """:func:`bifilar.identification.identify.identify`'s fixed point J = invert(T / ratio(J)), for the
     tensor: a period given at an amplitude is taken to zero amplitude by the law of the rig hung with
-    the fitted tensor, and the tensor refitted, until it moves by under the identify's tolerance (a
-    pass contracts the change by ~A^2). Without it the law was the start tensor's, and a hanging's
+    the fitted tensor, and the tensor refitted, until it has settled by identify's rule
+    (:func:`bifilar.identification.identify.settled`). Without it the law was the start tensor's, and a hanging's
     moment differed from identify's for the same rig, period and amplitude by ~1e-6 at 0.3 rad.
     Records are left as measured: their fit learns the law's excess from the record itself. ``hangings``:
     as hung with ``x``."""
+    step = np.inf
     for _ in range(AMPLITUDE_PASSES):
         fitted = identify_tensor(hangings, x, tares, src).inertia
         measured = [_measure(e, h, fitted) if e.amplitude > 0.0 and not e.signals else m
                     for e, h, m in zip(entries, held, measured)]
         hangings = _hangings(entries, held, measured, fitted, tare_of)
-        if np.abs(fitted - x).max() <= AMPLITUDE_RTOL * np.abs(fitted).max():
+        previous, step = step, np.abs(fitted - x).max() / np.abs(fitted).max()
+        if settled(step, previous):
             return fitted, measured, hangings
         x = fitted
     raise RigError(src, "hanging", f"the amplitude correction did not converge in {AMPLITUDE_PASSES} passes")

@@ -60,9 +60,14 @@ _REACH = np.log(1e6)  # J - J_min is searched within a factor 1e6 of the rig's o
 _MAX_STEPS = 2 * int(_REACH / _STEP)  # enough to cross the search range twice at the smallest limit
 _TOL = 1e-13  # |ln T - ln T_measured| at the root: rounding of a small eigenproblem
 _ROUNDING = 1e3 * np.finfo(float).eps  # eigh's absolute error on w2, relative to the largest w2
-# Amplitude correction: the fixed point J -> J(T / ratio(J)) contracts by ~A^2 per pass.
-AMPLITUDE_RTOL = 1e-9
-AMPLITUDE_PASSES = 8
+# Amplitude correction: the fixed point J -> J(T / ratio(J)) contracts by a factor k per pass (at most
+# ~A^2; ~0.004 measured at 0.3 rad on the trifilar). After a relative step s the error left is
+# ~s k / (1 - k), k measured as the ratio of the last two steps; the fixed point is settled when that is
+# under AMPLITUDE_RTOL (the inversion's own rounding, ~1e-13). A step that no longer shrinks (k >= 1/2)
+# below _RATIO_NOISE is the simulated ratio's floor (crossing times good to ~1e-10 of the period).
+AMPLITUDE_RTOL = 1e-13
+AMPLITUDE_PASSES = 12
+_RATIO_NOISE = 1e-10
 _CYCLES = 8  # periods simulated to measure T(A): crossing times fitted over 8 cycles
 _SAMPLES_PER_PERIOD = 100  # crossing refinement is good to ~1e-10 of the period at this rate
 # Integrator tolerance: the angles are O(1) rad, so the local error rtol is an error of rtol / A
@@ -312,14 +317,25 @@ def identify(rig: Rig, axis, period: float, amplitude: float = 0.0, rest: Rest |
     result = invert_period(rig, axis, period, rest, p)
     if amplitude == 0.0:
         return result
+    step = np.inf
     for _ in range(AMPLITUDE_PASSES):
         ratio = amplitude_ratio(result.rig, axis, amplitude, rest)
         new = invert_period(rig, axis, period / ratio, rest, p)
-        done = abs(new.moment / result.moment - 1.0) < AMPLITUDE_RTOL
+        previous, step = step, abs(new.moment / result.moment - 1.0)
         result = replace(new, amplitude_ratio=ratio)
-        if done:
+        if settled(step, previous):
             return result
     raise RigError(rig.source, "amplitude", f"{amplitude:g} rad: the amplitude correction did not converge")
+
+
+def settled(step: float, previous: float) -> bool:
+    """Whether an amplitude fixed point has settled, from its last two relative steps (``previous``
+    infinite on the first pass): the error left, ~step k / (1 - k) with k = step / previous, is under
+    :data:`AMPLITUDE_RTOL`, or the steps stopped shrinking at the simulated ratio's noise floor."""
+    if step < AMPLITUDE_RTOL or not np.isfinite(previous):
+        return step < AMPLITUDE_RTOL
+    k = step / previous
+    return (k < 0.5 and step * k / (1.0 - k) < AMPLITUDE_RTOL) or (k >= 0.5 and step < _RATIO_NOISE)
 
 
 def amplitude_coefficient(rig: Rig, axis, rest: Rest | None = None, amplitude: float = 0.05) -> float:
