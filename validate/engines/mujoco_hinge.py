@@ -66,7 +66,7 @@ def build_spec(rig: HingeRig, timestep: float = TIMESTEP, scene: bool = False) -
     opt.timestep = timestep
     opt.integrator = mujoco.mjtIntegrator.mjINT_RK4
     opt.gravity = [0.0, 0.0, -rig.gravity]
-    opt.disableflags |= mujoco.mjtDisableBit.mjDSBL_CONTACT
+    opt.disableflags |= mujoco.mjtDisableBit.mjDSBL_CONTACT | mujoco.mjtDisableBit.mjDSBL_ISLAND  # as validate.engines.mjcf
 
     r0 = rest_rotation(rig)
     origin = hinge_origin(rig)
