@@ -36,8 +36,8 @@ from bifilar.rig.file import rig_from_dict
 from bifilar.rig.ranges import MAX_PERIOD_SIGMA, MAX_RELATIVE_SIGMA, rig_size
 from bifilar.rig.statics import rest_pose
 
-from .measurement import said_once, start_moment
-from .identify import AMPLITUDE_PASSES, amplitude_ratio, invert_period, settled
+from .measurement import measure, said_once, start_moment
+from .identify import AMPLITUDE_PASSES, amplitude_ratio, axis_vector, invert_period, settled, with_moment
 from .records.law import EXCESS_PRIOR
 from .records.pipeline import RecordOptions, identify_records
 from .tensor import Hanging, Tare, Tensor, identify_tensor, moment_row, tensor_of
@@ -356,19 +356,26 @@ def _rig(data: dict, src: str, com=None, inertia=None) -> Rig:
 
 
 def _measure_fixture(t: _Tare) -> Fixture:
+    """The tare's fixture measured about its vertical at rest by :func:`.measurement.measure`, the step
+    ``identify`` takes, with the period's sigma alone propagated (``propagate="period"``): the tensor
+    fit propagates no rig geometry for any hanging, and the tare is one of its inputs."""
     data = read_toml(t.path)
     rig, unknown = _fixture_rig(data, str(t.path))
     axis = _vertical(rig)
-    measured = _measure_period(rig, axis, t.period, t.period_std, t.signals, t.options, 0.0)
-    found = invert_period(rig, axis, measured.period)
-    std = found.moment * measured.std / measured.period / found.sensitivity
-    fixture = found.rig
+    m = measure(rig, axis, period=t.period, period_std=t.period_std, signals=list(t.signals) if t.signals else None,
+                options=t.options, propagate="period")
+    period_std = m.period_std or 0.0
+    source = f"{len(m.trials)} record(s)" if t.signals else f"given, sigma: {_sigma_source(t.period_std, period_std)}"
+    measured = Measured(m.period, period_std, source, m.trials)
+    own = m if m.air is None else m.air  # in air: the body's own moment, as the hangings' rigs carry their air
+    moment, std = own.inertia, own.std or 0.0
+    fixture = with_moment(rig, axis_vector(axis), moment)  # as the inversion's rig (its axis is a unit vector)
     if unknown:  # a flat platform: I_xx = I_yy = I_zz / 2 where the file does not say
         inertia = fixture.inertia.copy()
         for i in unknown:
-            inertia[i, i] = 0.5 * found.moment
+            inertia[i, i] = 0.5 * moment
         fixture = replace(fixture, inertia=inertia)
-    return Fixture(fixture, axis, found.moment, std, measured, t.key, tuple(unknown))
+    return Fixture(fixture, axis, moment, std, measured, t.key, tuple(unknown))
 
 
 def _fixture_rig(data: dict, src: str) -> tuple[Rig, list[int]]:
@@ -402,11 +409,16 @@ def _measure_period(rig: Rig, axis, period, period_std, signals, options, amplit
         trials, pooled = identify_records(rig, axis, list(signals), options)
         return Measured(pooled.period, pooled.period_std, f"{len(trials)} record(s)", tuple(trials))
     std = rig.uncertainty.period if period_std is None else period_std
-    source = "period_std" if period_std is not None else ("the rig's [uncertainty].period" if std > 0.0 else "none")
+    source = _sigma_source(period_std, std)
     if amplitude > 0.0:
         ratio = amplitude_ratio(rig, axis, amplitude)
         return Measured(period / ratio, std / ratio, f"given at {amplitude:g} rad, sigma: {source}")
     return Measured(period, std, f"given, sigma: {source}")
+
+
+def _sigma_source(period_std: float | None, std: float) -> str:
+    """Where a given period's sigma ``std`` came from: the file's ``period_std``, else the rig's."""
+    return "period_std" if period_std is not None else ("the rig's [uncertainty].period" if std > 0.0 else "none")
 
 
 def _tare_in_all_or_none(entries: list[_Entry], src: str) -> None:

@@ -2,8 +2,9 @@
 
 :func:`measure` takes a rig (the body as hung; the unknown moment may be ``nan``) and a period timed at
 an amplitude, or record files, and returns a frozen :class:`Measurement`: the moment about a body axis
-with its propagated sigma and the sigma's parts, the figures per unit mass, the variance budget, the
-check of the identified tensor, the records' trials and the flags. :func:`subtract_tare` turns the
+with its propagated sigma (the period's and the rig file's, or the period's alone, as a hangings file's
+tare is measured for the tensor fit) and the sigma's parts, the figures per unit mass, the variance
+budget, the check of the identified tensor, the records' trials and the flags. :func:`subtract_tare` turns the
 measurements of an assembly and of its fixture alone into the object's own moment
 (:class:`ObjectMoment`). ``as_dict()`` is the JSON object ``identify --json`` prints (its fields:
 docs/identification.md); the CLI, the HTML page and the tensor's hangings read the typed fields.
@@ -28,13 +29,14 @@ from bifilar.rig import Rig, RigError
 
 from .air import added_moment, still, with_air
 from .identify import axis_vector, identify, invert_period, pencil, with_moment
-from .propagation import budget, linear_axes, monte_carlo
+from .propagation import budget, linear_axes, monte_carlo, period_only
 from .records.pipeline import Pooled, RecordOptions, Trial, identify_records
 from .transfer import object_part, parallel_axis_moment
 
 AXIS_INDEX = {"x": 0, "y": 1, "z": 2}
 WEAK_SENSITIVITY = 0.02  # d ln T / d ln I below this: the period barely depends on the moment
 Z95 = 1.959963984540054  # the standard normal's 97.5 % point: a 95 % interval is +- Z95 sigma
+PROPAGATE = ("all", "period")  # what measure() propagates: the period's sigma and the rig file's, or the period's
 
 
 @dataclass(frozen=True)
@@ -112,7 +114,7 @@ class Measurement:
 
     rig: str
     source: str
-    axis: str
+    axis: str | tuple[float, float, float]
     mass: float
     com: tuple[float, float, float]
     inertia: float
@@ -191,27 +193,36 @@ def start_moment(inertia: np.ndarray, k: int) -> float | None:
     return sum(known) / len(known) if known else None
 
 
-def _started(rig: Rig, axis: str) -> tuple[Rig, bool]:
+def _started(rig: Rig, axis) -> tuple[Rig, bool]:
     """The rig with a ``nan`` moment about ``axis`` replaced by :func:`start_moment` (the tensor's other
-    ``nan`` entries read as 0), and whether it was ``nan``."""
-    k = AXIS_INDEX[axis]
-    if not math.isnan(rig.inertia[k, k]):
+    ``nan`` entries read as 0), and whether it was ``nan``; about a vector axis the rig as given (its
+    start value is the caller's: :mod:`.hangings` reads a fixture's)."""
+    if not isinstance(axis, str) or not math.isnan(rig.inertia[AXIS_INDEX[axis], AXIS_INDEX[axis]]):
         return rig, False
     inertia = np.where(np.isnan(rig.inertia), 0.0, rig.inertia)
-    return with_moment(replace(rig, inertia=inertia), axis, start_moment(inertia, k)), True
+    return with_moment(replace(rig, inertia=inertia), axis, start_moment(inertia, AXIS_INDEX[axis])), True
 
 
-def measure(rig: Rig, axis: str, *, period: float | None = None, amplitude: float | None = None,
-            signals: Sequence | None = None, options: RecordOptions = RecordOptions(),
-            samples: int | None = None) -> Measurement:
-    """The moment about body axis ``axis`` (``x``, ``y`` or ``z``) from a ``period`` (s) timed at peak
-    rotation ``amplitude`` (rad; None or 0: small), or from ``signals`` (record files, or records
-    already read: trials of this rig, pooled), with the rig's ``[uncertainty]`` propagated linearly or,
-    with ``samples``, by that many Monte Carlo draws.
+def measure(rig: Rig, axis, *, period: float | None = None, amplitude: float | None = None,
+            period_std: float | None = None, signals: Sequence | None = None,
+            options: RecordOptions = RecordOptions(), samples: int | None = None,
+            propagate: str = "all") -> Measurement:
+    """The moment about body axis ``axis`` (``x``, ``y``, ``z``, or a body-frame vector: a fixture's
+    vertical at rest) from a ``period`` (s) timed at peak rotation ``amplitude`` (rad; None or 0: small)
+    with sigma ``period_std`` (s; None: the rig's ``[uncertainty].period``), or from ``signals`` (record
+    files, or records already read: trials of this rig, pooled), with the rig's ``[uncertainty]``
+    propagated linearly or, with ``samples``, by that many Monte Carlo draws. ``propagate``
+    (:data:`PROPAGATE`): ``"all"``, the period's sigma and the rig file's; ``"period"``, the period's
+    alone (:func:`.propagation.period_only`), as the tensor fit propagates it for every hanging: a tare
+    measured for the tensor (:mod:`.hangings`) leaves out what its hangings leave out.
 
     Raises :class:`RigError` for a period no moment gives (field ``period``) and for records that cannot
     be used, :class:`bifilar.identification.records.bounds.WorkSpent` once ``options.max_seconds`` is spent.
     """
+    if propagate not in PROPAGATE:
+        raise ValueError(f"propagate must be one of {PROPAGATE}, got {propagate!r}")
+    if not isinstance(axis, str):  # a vector: hashable, as the propagation keys its axes
+        axis = tuple(float(c) for c in axis)
     rig_in_air, was_nan = _started(rig, axis)
     rig = still(rig_in_air)  # the moment identified is the body's own: the air's added mass is in the model
     added = added_moment(rig, axis_vector(axis))  # reported: the apparent moment, the body's + the air's
@@ -222,8 +233,9 @@ def measure(rig: Rig, axis: str, *, period: float | None = None, amplitude: floa
     if signals is None:
         found = identify(rig, axis, period, amplitude or 0.0, p.lin.rest)
         ratio, small = found.amplitude_ratio, period / found.amplitude_ratio
-        small_std = rig.uncertainty.period / ratio
-        std_source = ("the rig file's [uncertainty].period" if small_std > 0.0 else
+        small_std = (rig.uncertainty.period if period_std is None else period_std) / ratio
+        std_source = ("the period's own sigma" if period_std is not None else
+                      "the rig file's [uncertainty].period" if small_std > 0.0 else
                       "none: the rig file states no [uncertainty].period")
     else:
         found_trials, pooled = identify_records(rig, axis, list(signals), options, p)
@@ -231,7 +243,7 @@ def measure(rig: Rig, axis: str, *, period: float | None = None, amplitude: floa
         small, small_std = pooled.period, pooled.period_std
         std_source = "the records' fits"
         flags.extend(record_flags(trials, pooled))
-    result = _propagate(rig, axis, small, small_std, samples, flags, p, added)
+    result = _propagate(rig, axis, small, small_std, samples, flags, p, added, propagate)
     result = replace(result, period_std_source=std_source,
                      start_value="nan in the rig file" if was_nan else "the rig file's value (a start only)",
                      amplitude=(amplitude, amplitude) if amplitude and signals is None else None,
@@ -252,15 +264,18 @@ def measure(rig: Rig, axis: str, *, period: float | None = None, amplitude: floa
 _NO_BODY = "the identified tensor"  # how the flag of a tensor no body has starts
 
 
-def _propagate(rig: Rig, axis: str, period: float, period_std: float, samples, flags: list, p,
-               added: float = 0.0) -> Measurement:
+def _propagate(rig: Rig, axis, period: float, period_std: float, samples, flags: list, p,
+               added: float = 0.0, propagate: str = "all") -> Measurement:
     """The propagated moment and everything derived from it (per mass, checks, flags); ``p`` is the
     rig's pencil about ``axis`` (its rest pose and linearisation); ``added``: the air's added moment
-    about ``axis``, added to the body's to report the apparent moment (its floor check is the body's).
-    The fields :func:`measure` sets after are left at placeholders."""
+    about ``axis``, added to the body's to report the apparent moment (its floor check is the body's);
+    ``propagate``: :func:`measure`'s. The fields :func:`measure` sets after are left at placeholders."""
     found = invert_period(rig, axis, period, p.lin.rest, p)
     geometry = [g for g in ("length", "anchor", "attach", "mass", "com") if getattr(rig.uncertainty, g) > 0.0]
-    if samples and (geometry or period_std > 0.0):
+    if propagate == "period":
+        geometry = []
+        result = period_only(found, period, period_std)
+    elif samples and (geometry or period_std > 0.0):
         result = monte_carlo(rig, axis, period, period_std, samples, np.random.default_rng(0))
     else:
         result = linear_axes(rig, {axis: period}, period_std, p.lin.rest, {axis: found}, p.lin)[axis]
@@ -274,7 +289,7 @@ def _propagate(rig: Rig, axis: str, period: float, period_std: float, samples, f
     per_mass_gradient[groups == "mass"] -= j / m**2
     std_pm = float(np.sqrt(np.sum((per_mass_gradient * inp.std) ** 2)))
     propagated = bool(np.any(inp.std > 0.0))
-    if not geometry:
+    if not geometry and propagate == "all":
         flags.append("the rig file has no [uncertainty] for geometry or mass: nothing of the rig was propagated"
                      + ("" if period_std > 0.0 else ", nor of the period: no uncertainty is stated"))
     floor = p.floor

@@ -20,7 +20,8 @@ curves, large against its ~1e-13 rounding); the period's own entry is dJ/dT = J 
 perturbed rig's rest pose is continued from the base pose and its mode's omega^2 taken as a Rayleigh
 quotient, shared by every axis and compiled (:mod:`bifilar.identification.slopes_kernel`); where the
 base equilibrium is singular, each perturbed rig is solved afresh (:func:`_slopes_resolved`). var J = sum_i (dJ/dx_i sigma_i)^2, the 95 % interval J +- 1.96 sigma,
-and the budget gives each group's share of the variance.
+and the budget gives each group's share of the variance. :func:`period_only` is that entry alone, the rig's
+inputs left out (the tensor fit's choice for every hanging, and so for its tares).
 
 Monte Carlo (:func:`monte_carlo`): the inputs drawn around their measured values and each draw
 inverted; the standard deviation and the 2.5 / 97.5 % quantiles of the draws, and a budget from the
@@ -168,6 +169,19 @@ def propagate(base: Identified, slopes: np.ndarray, own: Inputs) -> Propagation:
     gradient[-1] = 1.0 / (base.period * dlnT_dJ)  # dJ / dT of the measured period
     gradient = np.where(own.std > 0.0, gradient, 0.0)
     std = float(np.sqrt(np.sum((gradient * own.std) ** 2)))
+    return Propagation(base.moment, std, base.moment - _Z * std, base.moment + _Z * std, "linear",
+                       budget(own, gradient), own, gradient)
+
+
+def period_only(base: Identified, period: float, period_std: float) -> Propagation:
+    """The period's sigma alone propagated to the moment, to first order (dJ / dT = J / (T d ln T / d ln J)),
+    the rig's geometry and mass left out: what the tensor fit propagates for every hanging
+    (:func:`bifilar.identification.measurement.measure` with ``propagate="period"``)."""
+    own = inputs(base.rig, period, period_std)
+    own = replace(own, std=np.where(np.array(own.groups) == "period", own.std, 0.0))
+    gradient = np.zeros(len(own.values))
+    gradient[-1] = base.moment / period / base.sensitivity
+    std = base.moment * period_std / period / base.sensitivity
     return Propagation(base.moment, std, base.moment - _Z * std, base.moment + _Z * std, "linear",
                        budget(own, gradient), own, gradient)
 

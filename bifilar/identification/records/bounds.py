@@ -1,7 +1,7 @@
 """Work bounds of the record fit (:mod:`.fit`): it never runs without end, whatever the record.
 
 The fit cuts a record into windows one local period long, the local frequency being what the last
-pass's amplitude law gives (:meth:`.phase_law.Model.local`). A law fitted to a record it cannot describe
+pass's amplitude law gives (:meth:`.phase_fit.PhaseFit.local`). A law fitted to a record it cannot describe
 (seconds read as milliseconds: the exact law's lam omega^2 a million times a real rig's; a swing near
 the law's limit, where T(A) runs off) can give a frequency that is zero, negative or not finite, and a
 loop stepping by it never ends. :func:`window_centres` holds every local frequency to a band about the

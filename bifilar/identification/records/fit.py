@@ -68,7 +68,8 @@ from .bounds import Deadline, binned
 from .clean import Rejected, spans, stuck
 from .cycles import Cycles, Samples, baseline_of, measure, rough_frequency
 from .law import EXCESS_PRIOR, LINEAR, AmplitudeLaw
-from .phase_law import EXCESS_TERMS, LAW_CONFLICT, Model, pendulum, swing_of
+from .phase_fit import EXCESS_TERMS, PhaseFit
+from .phase_law import LAW_CONFLICT, Model, pendulum, swing_of, unwrap
 from .read import KINDS, MIN_CYCLES, MIN_SAMPLES
 from .second_mode import second_mode_of
 from .spread import few_blocks
@@ -193,18 +194,17 @@ def fit_oscillation(t, y, kind: str, law: AmplitudeLaw = LINEAR, *, excess_prior
     second = None
     cyc = measure(rec, baseline, lambda c: (np.full(len(c), omega), np.zeros(len(c))), second)
     _check_swing(cyc, law, kind)
-    model.fit(cyc)
+    phase = model.fit(cyc)
     for _ in range(_PASSES):
         if second_mode:  # (re-)estimated on the record as it is, under the latest first mode
-            second = second_mode_of(rec, cyc, baseline, model)
-        cyc = measure(rec, baseline, model.local, second)
-        model.fit(cyc)
+            second = second_mode_of(rec, cyc, baseline, phase)
+        cyc = measure(rec, baseline, phase.local, second)
+        phase = model.fit(cyc, phase)
         baseline = baseline + baseline_of(rec.tau, cyc)  # the offsets left under the last baseline
-    cyc = measure(rec, baseline, model.local, second)
-    model.fit(cyc, slips=True)
-    model.check_law(cyc)
-    whole = fit_whole(rec, cyc, model, baseline, second)
-    return _result(rec, t, cyc, model, baseline, whole, rejected, law.kind)
+    cyc = measure(rec, baseline, phase.local, second)
+    phase = model.check_law(model.fit(cyc, phase, slips=True), cyc)
+    whole = fit_whole(rec, cyc, phase, baseline, second)
+    return _result(rec, t, cyc, model, phase, baseline, whole, rejected, law.kind)
 
 
 class SwingError(ValueError):
@@ -229,8 +229,8 @@ def _check_swing(cyc: Cycles, law: AmplitudeLaw, kind: str) -> None:
         raise SwingError(largest, law.limit)
 
 
-def _result(rec: Samples, t: np.ndarray, cyc: Cycles, model: Model, baseline: np.ndarray, whole: Whole,
-            rejected: Rejected, ideal_kind: str = "linear") -> OscillationFit:
+def _result(rec: Samples, t: np.ndarray, cyc: Cycles, model: Model, phase: PhaseFit, baseline: np.ndarray,
+            whole: Whole, rejected: Rejected, ideal_kind: str = "linear") -> OscillationFit:
     good = cyc.good & np.isfinite(cyc.phase)
     omega0 = whole.omega0
     period = 2.0 * math.pi / omega0
@@ -241,15 +241,15 @@ def _result(rec: Samples, t: np.ndarray, cyc: Cycles, model: Model, baseline: np
     # excess term fewer), and past LAW_CONFLICT the ideal law's T0 (the record's beat or the rig file's
     # law is wrong); the interval holds both T0s of each (the record's doubt, not the prior's that the
     # trials share)
-    base = whole.variance + model.law_induced_variance() + model.held_shift**2
+    base = whole.variance + phase.law_induced_variance() + phase.held_shift**2
     # the extrapolation's doubt where it is more than the sigma already holds: the sigma is at least the
     # difference of the two extrapolations (where the record determines the law it is well inside it)
-    order = max(0.0, model.order_shift**2 - base)
-    held = model.held_shift**2 + order
-    std_law = to_period * math.sqrt(model.cov_law[1, 1] + held)
+    order = max(0.0, phase.order_shift**2 - base)
+    held = phase.held_shift**2 + order
+    std_law = to_period * math.sqrt(phase.cov_law[1, 1] + held)
     std_all = to_period * math.sqrt(base + order)
     std_stat = math.sqrt(max(std_all**2 - std_law**2, to_period**2 * whole.variance))
-    jack, groups = model.jackknife(cyc)
+    jack, groups = model.jackknife(phase, cyc)
     if not (groups and jack > (std_stat / to_period) ** 2 * chi2.ppf(0.95, groups - 1) / (groups - 1)):
         groups = 0  # the covariance holds (the jackknife, a variance of groups - 1 dof, is not above it at 95 %)
     else:  # the covariance is short: the jackknife's, scaled to its Student-t interval as the blocks are
@@ -290,40 +290,40 @@ def _result(rec: Samples, t: np.ndarray, cyc: Cycles, model: Model, baseline: np
     rejected.spans = spans(t, out_cycles | glitch | ~rec.usable, 3.0 * rec.step)
     # the cycles, for plots and the law's report
     centre = cyc.centre[good]
-    fund = model.fund_at(centre)
-    amplitude_rad = model.peak_at(centre) if model.law.kind != "linear" else None
+    fund = phase.fund_at(centre)
+    amplitude_rad = phase.peak_at(centre) if model.law.kind != "linear" else None
     if model.kind in ("angle", "rate") and model.law.kind == "linear":
         amplitude_rad = fund  # a linear law: the fundamental is the peak
-    unwrapped = model.unwrap(cyc, good, centre)
+    unwrapped = unwrap(cyc, good)
     neighbours = np.diff(np.flatnonzero(good)) == 1
     per_cycle = np.where(neighbours, 2.0 * math.pi * np.diff(centre) / np.maximum(np.diff(unwrapped), 1e-300), np.nan)
     cycle_amp = amplitude_rad if amplitude_rad is not None else fund
-    names = model.names
-    std = np.sqrt(np.diag(model.cov_stat + model.cov_law))
-    excess = model.params[names.index("ds")] if "ds" in names else 0.0
-    quartic = model.params[names.index("dq")] if "dq" in names else 0.0
+    names = phase.names
+    std = np.sqrt(np.diag(phase.cov_stat + phase.cov_law))
+    excess = phase.params[names.index("ds")] if "ds" in names else 0.0
+    quartic = phase.params[names.index("dq")] if "dq" in names else 0.0
     learned = 0.0
     if "ds" in names:
         i = names.index("ds")
-        prior_sd = model.prior * abs(model.ideal)
+        prior_sd = model.prior * abs(phase.ideal)
         learned = max(0.0, 1.0 - std[i] ** 2 / prior_sd**2) if prior_sd > 0 else 0.0
     note = ""
     if model.kind == "proportional" and "kappa" not in names and "q" not in names and ideal_kind != "linear":  # linear: no law to apply
         note = ("scale unknown: the ideal law cannot be applied; T0 is the period at the record's amplitudes "
                 "(a small swing assumed)")
     law = Law("none (scale unknown)" if note else model.law.kind,
-              model.ideal, float(excess), float(std[names.index("ds")]) if "ds" in names else 0.0,
+              phase.ideal, float(excess), float(std[names.index("ds")]) if "ds" in names else 0.0,
               float(quartic), float(std[names.index("dq")]) if "dq" in names else 0.0, float(learned), note,
-              model.conflict if model.conflict > LAW_CONFLICT else None, model.rises, to_period * model.ideal_shift)
-    curve = _law_curve(model, period, cycle_amp)
+              phase.conflict if phase.conflict > LAW_CONFLICT else None, phase.rises, to_period * phase.ideal_shift)
+    curve = _law_curve(model, phase, period, cycle_amp)
     level = cyc.offset[good] + np.interp(centre, rec.tau, baseline)  # the offset under each cycle
     amplitude = None
-    if model.scale_known and amplitude_rad is not None:
+    if phase.scale_known and amplitude_rad is not None:
         amplitude = (float(amplitude_rad[0]), float(amplitude_rad[-1]))
     return OscillationFit(
         period=period, period_std=math.hypot(std_stat, std_law), period_std_statistical=std_stat,
-        period_std_law=std_law, period_std_white=std_white, prior_gain=to_period * model.prior_gain, law=law,
-        amplitude=amplitude, damping=model.damping, offset=float(np.median(cyc.offset[good])),
+        period_std_law=std_law, period_std_white=std_white, prior_gain=to_period * phase.prior_gain, law=law,
+        amplitude=amplitude, damping=phase.damping, offset=float(np.median(cyc.offset[good])),
         drift=float(np.polyfit(centre, cyc.offset[good] + np.interp(centre, rec.tau, baseline), 1)[0])
         if len(centre) > 1 else 0.0,
         rms=rms, outliers=t[glitch], rejected=rejected,
@@ -334,18 +334,18 @@ def _result(rec: Samples, t: np.ndarray, cyc: Cycles, model: Model, baseline: np
         binned=rec.binned, crb=to_period * math.sqrt(whole.bound.variance), crb_noise=whole.bound.noise)
 
 
-def _law_curve(model: Model, period: float, amplitude: np.ndarray):
+def _law_curve(model: Model, phase: PhaseFit, period: float, amplitude: np.ndarray):
     """(A, T(A) fitted, T(A) ideal) over the record's amplitude range, for plots."""
     a = np.linspace(0.0, float(np.max(amplitude)) * 1.05, 60)
-    if model.law.kind == "linear" or model.table is None or not model.scale_known:
+    if model.law.kind == "linear" or phase.table is None or not phase.scale_known:
         flat = np.full(len(a), period)
         return a, flat, flat
-    names, p = model.names, model.params
+    names, p = phase.names, phase.params
     kappa = p[names.index("kappa")] if "kappa" in names else 1.0
     a_rad = a * kappa if model.kind == "proportional" else a
     if "q" in names:
-        a_rad = swing_of(math.sqrt(p[names.index("q")]) * a, model.harmonic[2])
-    ideal = period * model.table.ratio_at(np.minimum(a_rad, model.table.largest))
+        a_rad = swing_of(math.sqrt(p[names.index("q")]) * a, phase.harmonic[2])
+    ideal = period * phase.table.ratio_at(np.minimum(a_rad, phase.table.largest))
     excess = 1.0
     if "ds" in names:
         excess = 1.0 + sum(p[names.index(n)] * a_rad ** (2 * (j + 1)) for j, n in enumerate(EXCESS_TERMS))

@@ -1,23 +1,26 @@
 """The phases' law: every measured cycle's phase on one curve, Phi(t) = phi0 + omega0 int dt / (R E D).
 
 Steps 4 and 5 of the record fit (:mod:`.fit`). The cycles (:mod:`.cycles`) each give a phase and an
-amplitude; :class:`Model` asks one thing of all of them together, the rig's amplitude law: A(t) the
-peak amplitude (the cycles' amplitudes through the waveform the record shows, ln A a Chebyshev series
-of the degree Akaike's criterion allows: :class:`_Envelope`), R the ideal law (:mod:`.law`), E = 1 + ds A^2 +
-dq A^4 + d6 A^6 the real rig's excess with Gaussian priors, D the damping's shift of the frequency
+amplitude; :class:`Model` asks one thing of all of them together, the rig's amplitude law, and returns
+it fitted, a frozen :class:`.phase_fit.PhaseFit`: A(t) the peak amplitude (the cycles' amplitudes through
+the waveform the record shows, ln A a Chebyshev series of the degree Akaike's criterion allows:
+:class:`_Envelope`), R the ideal law (:mod:`.law`), E = 1 + ds A^2 + dq A^4 + d6 A^6 the real rig's
+excess with Gaussian priors, D the damping's shift of the frequency
 (:mod:`.damping`). Weighted least squares gives omega0 = 2 pi / T0 and the excess; the covariance is
 the block sandwich of :mod:`.spread` plus what the envelope's own uncertainty adds, the priors' part
 apart, and a delete-a-group jackknife (:meth:`Model.jackknife`) checks it. A proportional record of a
 compound pendulum has its scale q = kappa^2 from its own third harmonic (:func:`harmonic_scale`), a prior
 of the fit whose doubt is the law's part of T0's sigma. The learned law's own doubts
 (its extrapolation to zero swing, a law no rig has) are measured by refitting (:meth:`Model.check_law`).
-The law's local frequency and decay are what the next pass's windows are fitted with (:meth:`Model.local`).
+Every refit is a new fit of the same :class:`Model` under other options, never the fit changed in place.
+The law's local frequency and decay are what the next pass's windows are fitted with
+(:meth:`.phase_fit.PhaseFit.local`).
 """
 
 from __future__ import annotations
 
-import copy
 import math
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -25,6 +28,7 @@ from .cycles import Cycles
 from .damping import damping_of, damping_shift
 from .law import AmplitudeLaw, Table
 from .near import envelope_rises
+from .phase_fit import EXCESS_TERMS, PhaseFit
 from .read import MIN_CYCLES
 from .spread import sandwich, white_and_blocks
 
@@ -42,9 +46,6 @@ _ENVELOPE_DEGREE = 8  # at most: ln A of a decay to a third of the start over th
 # long on average over 40 white-noise records), one too many only adds variance, which the covariance
 # carries (Murphy-Topel). At 9 (an F test at ~3 sigma) it was that bias; at 2, z -0.02 +- 0.10.
 _ENVELOPE_F = 2.0
-# The real law's excess E = 1 + ds A^2 + dq A^4 + d6 A^6: a stronger cubic restoring term alone already
-# gives all three (over 0.4..1.25 rad, A^2 and A^4 alone leave 2e-4 of it, enough to bias T0 by 1e-4).
-EXCESS_TERMS = ("ds", "dq", "d6")
 # A record whose T(A) asks for an excess this many prior sigmas from the ideal law at some amplitude it
 # swung through follows no rig's law (real ones differ by up to 30-40 %, about one prior sigma): a mode
 # close to the torsion's frequency beating in (its slow phase wobble reads as a chirp), or a rig file
@@ -55,59 +56,62 @@ LAW_CONFLICT = 3.0
 _HELD = 1e-6  # a held excess's prior sd, relative to the prior's own: the data cannot move it
 
 
+@dataclass(frozen=True)
 class Model:
-    """The phases' law (module docstring; :mod:`.fit`, step 4) fitted to the good cycles of a pass.
+    """The phases' law (module docstring; :mod:`.fit`, step 4): its configuration, the ideal law ``law``,
+    the record's ``kind``, the excess's ``prior`` (relative sd) and a proportional record's
+    ``max_amplitude`` (rad). :meth:`fit` fits it to the good cycles of a pass and returns a frozen
+    :class:`.phase_fit.PhaseFit`; the refits that measure the fit's doubts (:meth:`check_law`,
+    :meth:`jackknife`) are the same solve under other options, each a new fit.
 
     The amplitude the law is evaluated at is measured with noise too: it is a smooth envelope fitted to
     the cycles' amplitudes alone (:class:`_Envelope`), and what its uncertainty does to T0 is added to
-    the covariance (:meth:`_covariance`).
+    the covariance (:func:`_covariance`).
     """
 
-    def __init__(self, law: AmplitudeLaw, kind: str, prior: float, max_amplitude: float | None):
-        self.law, self.kind, self.prior, self.max_amplitude = law, kind, prior, max_amplitude
-        self.omega0 = None
-        self.table: Table | None = None
-        self.parent: Model | None = None  # a jackknife refit's: its damping shift and start are the parent's
-        self.held = False  # the excess held at the ideal law (:meth:`check_law`'s fit)
-        self.terms = len(EXCESS_TERMS)  # the excess terms free: the rest held at zero (:meth:`check_law`)
-        self.order_shift = 0.0  # omega0 learned less omega0 with one excess term fewer (rad/s)
-        self.conflict = 0.0  # the largest excess of the last fit, in prior sigmas
-        self.held_shift = 0.0  # omega0 learned less omega0 under the ideal law (rad/s), past LAW_CONFLICT
-        self.ideal_shift = 0.0  # the same, whatever the conflict: what a law shared with other records weighs
-        self.rises = False  # the cycles' envelope rises again (.near.envelope_rises): a mode beating in
-        self.harmonic = None  # a proportional record's scale from its third harmonic (:func:`harmonic_scale`)
+    law: AmplitudeLaw
+    kind: str
+    prior: float
+    max_amplitude: float | None
 
-    def _table(self, omega: float, largest: float) -> Table:
-        """The law's table at ``omega`` up to ``largest`` rad, recomputed when omega moves by over 1e-6
-        of itself: the exact law's R depends on it through lam omega^2 (d R / d ln omega = eps A^2 / 2
-        < 0.1 for any rig's eps and A < 1.4 rad), so R stays right to 1e-7."""
-        key = getattr(self, "_key", None)
+    def _table(self, previous: PhaseFit | None, omega: float, largest: float) -> tuple[tuple[float, float], Table]:
+        """(key, table): the law's table at ``omega`` up to ``largest`` rad, the ``previous`` fit's unless
+        omega moved by over 1e-6 of it or the table is too short: the exact law's R depends on omega through
+        lam omega^2 (d R / d ln omega = eps A^2 / 2 < 0.1 for any rig's eps and A < 1.4 rad), so R stays
+        right to 1e-7."""
+        key = None if previous is None else previous.table_key
         if key is None or abs(key[0] / omega - 1.0) > 1e-6 or key[1] < largest:
-            self._key, self._cached = (omega, largest), self.law.table(omega, largest)
-        return self._cached
+            return (omega, largest), self.law.table(omega, largest)
+        return key, previous.table
 
-    def fit(self, cyc: Cycles, slips: bool = False) -> None:
-        """Fit the good cycles; with ``slips``, cycles whose phase is far off the law are left out
-        (the tracker jumped) and the rest refitted."""
+    def fit(self, cyc: Cycles, previous: PhaseFit | None = None, slips: bool = False) -> PhaseFit:
+        """The law fitted to the good cycles, from the ``previous`` pass's omega0 (and its table; the
+        cycles' median frequency on the first pass); with ``slips``, cycles whose phase is far off the law
+        are marked bad in ``cyc`` (the tracker jumped) and the rest refitted."""
         good = cyc.good & np.isfinite(cyc.phase)
         for _ in range(3):
             if good.sum() < MIN_CYCLES:
                 raise ValueError(f"{int(good.sum())} cycles could be measured on their own; at least "
                                  f"{MIN_CYCLES} are needed")
-            self._solve(cyc, good)
+            previous = self._solve(cyc, good, previous)
             if not slips:
                 break
-            z = self.residual / np.sqrt(self.var)
+            z = previous.residual / np.sqrt(previous.var)
             robust = 1.4826 * float(np.median(np.abs(z))) or 1.0
-            slip = (np.abs(z) > _PHASE_Z * max(robust, 1.0)) & (np.abs(self.residual) > _SLIP_FLOOR)
+            slip = (np.abs(z) > _PHASE_Z * max(robust, 1.0)) & (np.abs(previous.residual) > _SLIP_FLOOR)
             if not slip.any():
                 break
             for k in np.flatnonzero(good)[slip]:
                 cyc.good[k] = False
                 cyc.reason[k] = "phase slips off the law (the tracker jumped)"
             good = cyc.good & np.isfinite(cyc.phase)
+        return previous
 
-    def _solve(self, cyc: Cycles, good: np.ndarray) -> None:
+    def _solve(self, cyc: Cycles, good: np.ndarray, previous: PhaseFit | None, free: int = len(EXCESS_TERMS),
+               held: bool = False, parent: PhaseFit | None = None) -> PhaseFit:
+        """One fit of the cycles ``good``, started from ``previous`` (:meth:`fit`), with the first ``free``
+        excess terms free and the rest held at zero, or all ``held`` at the ideal law (:meth:`check_law`);
+        a jackknife refit (:meth:`jackknife`) takes its ``parent``'s scale, damping shift and start."""
         centre, var = cyc.centre[good], cyc.phase_var[good]
         n = len(centre)
         # the cycles' peak amplitudes (signal units; of the angle for a rate) and their ln variances
@@ -119,7 +123,7 @@ class Model:
         envelope = _Envelope(centre, np.log(peak_data), log_sd)
         b_grid = envelope.basis(grid)
         amp_grid = np.exp(b_grid @ envelope.beta)
-        omega = float(np.median(cyc.omega[good])) if self.omega0 is None else self.omega0
+        omega = float(np.median(cyc.omega[good])) if previous is None else previous.omega0
         largest = float(amp_grid.max())
         law_on = self.law.kind != "linear"
         kappa_max = None
@@ -128,27 +132,25 @@ class Model:
             kappa_max = self.max_amplitude / largest if self.max_amplitude is not None else None
             largest_rad = self.max_amplitude or 0.0
             if kappa_max is None and law_on and pendulum(self.law):
-                if self.parent is not None and self.parent.harmonic is not None:
-                    harmonic = self.parent.harmonic  # a jackknife refit: the scale's doubt is the law's part
+                if parent is not None and parent.harmonic is not None:
+                    harmonic = parent.harmonic  # a jackknife refit: the scale's doubt is the law's part
                 else:
                     harmonic = harmonic_scale(np.exp(envelope.basis(centre) @ envelope.beta),
                                               cyc.third[good], cyc.third_var[good])
-                self.harmonic = harmonic
                 q_top = harmonic[0] + 6.0 * harmonic[1]
                 largest_rad = swing_of(math.sqrt(max(q_top, 0.0)) * largest, harmonic[2])
         else:
             largest_rad = largest
         s = self.law.coefficient(omega)
-        if law_on:
-            self.table = self._table(omega, 1.05 * largest_rad)
-        phase = self.unwrap(cyc, good, grid)
+        table_key, table = self._table(previous, omega, 1.05 * largest_rad) if law_on else (None, None)
+        phase = unwrap(cyc, good)
         names = ["phi", "omega"]
         start = [0.0, omega]
         priors = []  # (index, centre, sd)
         if law_on and self.prior > 0.0:
             names += list(EXCESS_TERMS)
             start += [0.0] * len(EXCESS_TERMS)
-            priors += [(2 + j, 0.0, (_HELD if self.held or j >= self.terms else 1.0) * self.prior * abs(s))
+            priors += [(2 + j, 0.0, (_HELD if held or j >= free else 1.0) * self.prior * abs(s))
                        for j in range(len(EXCESS_TERMS))]
         if harmonic is not None:
             names.append("q")
@@ -163,14 +165,14 @@ class Model:
         at_ref = float(np.interp(ref, grid, np.arange(len(grid))))
         weights = 1.0 / np.sqrt(var)
         # the damping's own lengthening of the period, second order in it (:func:`damping_shift`)
-        if self.parent is None:
+        if parent is None:
             damping = damping_of(grid, amp_grid, omega)
             shift = damping_shift(damping, amp_grid)
         else:  # a ~1e-5 effect that leaving out a group of cycles moves by a few % of itself
-            damping = self.parent.damping
-            shift = np.interp(amp_grid, *self.parent.shift_curve)
+            damping = parent.damping
+            shift = np.interp(amp_grid, *parent.shift_curve)
         order = np.argsort(amp_grid)
-        self.shift_curve = (amp_grid[order], shift[order])
+        shift_curve = (amp_grid[order], shift[order])
         slow = 1.0 / (1.0 + shift)
 
         def terms(p):
@@ -182,20 +184,20 @@ class Model:
             kappa = p[names.index("kappa")] if "kappa" in names else 1.0
             if "q" in names:  # q = kappa^2; a rate's peak is 2 sin(A / 2) of the angle's (the energy)
                 x = math.sqrt(max(p[names.index("q")], 0.0)) * amp
-                a = np.minimum(swing_of(x, harmonic[2]), self.table.largest)
+                a = np.minimum(swing_of(x, harmonic[2]), table.largest)
                 da_dx = 1.0 / np.sqrt(np.maximum(1.0 - 0.25 * x * x, 1e-12)) if harmonic[2] else np.ones_like(x)
             else:
-                a = np.minimum(kappa * amp, self.table.largest)
+                a = np.minimum(kappa * amp, table.largest)
             a2 = a * a
             d = p[2:2 + len(EXCESS_TERMS)] if "ds" in names else np.zeros(len(EXCESS_TERMS))
             powers = [a2 ** (j + 1) for j in range(len(EXCESS_TERMS))]
             excess = 1.0 + sum(dj * pw for dj, pw in zip(d, powers))
             growth = sum(2.0 * (j + 1) * dj * a2**j for j, dj in enumerate(d))  # dE/da / a
-            ratio = self.table.ratio_at(a)
+            ratio = table.ratio_at(a)
             g = slow / (ratio * excess)
             # d g / d a over a, finite at a = 0 (R is even in A)
             floor = np.maximum(a, 1e-6)
-            dg_da_a = -g * (self.table.ratio_slope(floor) / floor / ratio + growth / excess)
+            dg_da_a = -g * (table.ratio_slope(floor) / floor / ratio + growth / excess)
             dg_da = dg_da_a * a
             dg_dlna = a * dg_da if "q" not in names else dg_da_a * a * x * da_dx
             slopes = [-g * pw / excess for pw in powers] if "ds" in names else []
@@ -228,8 +230,8 @@ class Model:
         # record at one amplitude leaves a direction to the priors alone, which finite differences of a
         # residual weighted by 1 / sigma_phase would drown in rounding.
         p = np.array(start, dtype=float)
-        if self.parent is not None:
-            p = self.parent.params.copy()
+        if parent is not None:
+            p = parent.params.copy()
         p[0] = float(np.average(phase - p[1] * integral(terms(p)[1]), weights=weights**2))
         for _ in range(40):
             r_phase, j_phase, _, rp, jp = evaluate(p)
@@ -249,72 +251,35 @@ class Model:
                 break
         r_phase, j_phase, j_envelope, rp, jp = evaluate(p)
         a_fit, g_fit, _, _ = terms(p)
-        self.names, self.params, self.omega0 = names, p, float(p[1])
-        if "ds" in names and not self.held:  # the excess at each amplitude swung through, in prior sigmas
+        conflict = 0.0
+        if "ds" in names and not held:  # the excess at each amplitude swung through, in prior sigmas
             powers = np.array([(a_fit * a_fit) ** (j + 1) for j in range(len(EXCESS_TERMS))])
             sd = self.prior * abs(s) * np.sqrt(np.sum(powers**2, axis=0))
-            self.conflict = float(np.max(np.abs(p[2:2 + len(EXCESS_TERMS)] @ powers) / np.maximum(sd, 1e-300)))
-        self.residual, self.var = r_phase / weights, var
-        self.ideal = s if law_on else None
-        self.damping = damping
-        self.scale_known = self.kind != "proportional" or "kappa" in names or "q" in names
-        amp_signal = amp_grid
-        slope = envelope.basis(grid, derivative=1) @ envelope.beta
-        self.fund_at = lambda tt: np.interp(tt, grid, amp_signal)
-        self.peak_at = (lambda tt: np.interp(tt, grid, a_fit)) if law_on else (lambda tt: None)
-        self.rate_at = lambda tt: np.interp(tt, grid, g_fit)
-        self.decay_at = lambda tt: np.interp(tt, grid, slope)
-        cum = _from_reference(grid, g_fit, at_ref)
-        self.phase_integral = (grid, cum, float(p[0]), float(p[1]), float(g_fit[0]), float(g_fit[-1]))
-        # the integral's response to each law parameter (names[2:]) and their priors' sds, for the
-        # Cramér-Rao bound of a whole fit with the law free (:mod:`.bound`)
-        self.law_slopes = [(grid, _from_reference(grid, d, at_ref), float(d[0]), float(d[-1])) for d in terms(p)[3]]
-        self.law_prior_sd = np.array([sd for _, _, sd in sorted(priors)])
-        self._covariance(j_phase, jp, r_phase, j_envelope, envelope.cov)
+            conflict = float(np.max(np.abs(p[2:2 + len(EXCESS_TERMS)] @ powers) / np.maximum(sd, 1e-300)))
+        cov_stat, cov_law, prior_gain = _covariance(j_phase, jp, r_phase, j_envelope, envelope.cov, "ds" in names)
+        return PhaseFit(
+            names=tuple(names), params=p, omega0=float(p[1]), cov_stat=cov_stat, cov_law=cov_law,
+            prior_gain=prior_gain, residual=r_phase / weights, var=var, ideal=s if law_on else None,
+            conflict=conflict, held=held, scale_known=self.kind != "proportional" or "kappa" in names or "q" in names,
+            damping=damping, shift_curve=shift_curve, harmonic=harmonic, table=table, table_key=table_key,
+            grid=grid, amplitude=amp_grid, peak=a_fit if law_on else None, rate=g_fit,
+            decay=envelope.basis(grid, derivative=1) @ envelope.beta,
+            phase_integral=(grid, _from_reference(grid, g_fit, at_ref), float(p[0]), float(p[1]), float(g_fit[0]),
+                            float(g_fit[-1])),
+            # the integral's response to each law parameter (names[2:]) and their priors' sds, for the
+            # Cramér-Rao bound of a whole fit with the law free (:mod:`.bound`)
+            law_slopes=tuple((grid, _from_reference(grid, d, at_ref), float(d[0]), float(d[-1])) for d in terms(p)[3]),
+            law_prior_sd=np.array([sd for _, _, sd in sorted(priors)]))
 
-    def unwrap(self, cyc: Cycles, good: np.ndarray, grid: np.ndarray) -> np.ndarray:
-        """The good cycles' phases made continuous: each one within pi of its predecessor advanced by
-        the local frequency over the time between them."""
-        centre, phase, omega = cyc.centre[good], cyc.phase[good], cyc.omega[good]
-        out = np.empty(len(phase))
-        out[0] = phase[0]
-        for k in range(1, len(phase)):
-            advance = 0.5 * (omega[k] + omega[k - 1]) * (centre[k] - centre[k - 1])
-            predicted = out[k - 1] + advance
-            out[k] = phase[k] + 2.0 * math.pi * round((predicted - phase[k]) / (2.0 * math.pi))
-        return out
-
-    def _covariance(self, jd, jp, r, j_envelope, cov_envelope) -> None:
-        """:mod:`.fit`, step 5: white, block sandwich (at least the white one), the priors', and
-        what the envelope's own uncertainty adds (a two-step estimate's correction, Murphy and Topel:
-        H^-1 (J^T J_A) V_A (J_A^T J) H^-1, J_A the phases' response to the envelope's coefficients)."""
-        hessian = jd.T @ jd + jp.T @ jp
-        # equilibrated before the inverse: the columns differ by ~1e3 in scale (phase, omega0 times the
-        # record's span, the excess times A^2), and at a nearly constant swing the direction only the
-        # priors fix has ~1e-10 of the largest curvature, which pinv's cut would otherwise round away
-        scale = 1.0 / np.sqrt(np.maximum(np.diag(hessian), 1e-300))
-        bread_inv = scale[:, None] * np.linalg.pinv(scale[:, None] * hessian * scale[None, :]) * scale[None, :]
-        stat_white, stat_sand, block = white_and_blocks(jd, r, bread_inv)
-        cross = jd.T @ j_envelope
-        envelope = bread_inv @ cross @ cov_envelope @ cross.T @ bread_inv
-        self.block = block
-        self.cov_white = bread_inv @ (jd.T @ jd) @ bread_inv
-        self.cov_stat = (stat_sand if stat_sand[1, 1] > stat_white[1, 1] else stat_white) + envelope
-        self.cov_law = bread_inv @ (jp.T @ jp) @ bread_inv
-        # T0's response to the law's prior being off by one sigma in each of its excess terms (their rows
-        # come first): records of one rig share that error, while a proportional record's scale is its own
-        law_rows = len(EXCESS_TERMS) if "ds" in self.names else 0
-        self.prior_gain = (bread_inv @ jp.T)[1, :law_rows]
-
-    def check_law(self, cyc: Cycles) -> None:
-        """Two doubts of the learned law that T0's sigma carries (:func:`.fit._result`: the first where it
-        is more than the sigma already holds), each the same cycles refitted: :attr:`order_shift`,
-        omega0 as fitted less omega0 with the excess's last term held at zero, and past
-        :data:`LAW_CONFLICT` :attr:`held_shift`, omega0 less omega0 with the whole excess held at the
-        ideal law; the same where the cycles' envelope rises (:func:`.near.envelope_rises`: a mode
-        beating in, which the law learns as a frequency moving with the swing, within its prior).
-        That difference is kept whatever the conflict (:attr:`ideal_shift`): fits of one rig whose
-        learned laws disagree hold it (:func:`.pipeline._own_variances`).
+    def check_law(self, fit: PhaseFit, cyc: Cycles) -> PhaseFit:
+        """``fit`` with two doubts of the learned law that T0's sigma carries (:func:`.fit._result`: the
+        first where it is more than the sigma already holds), each the same cycles refitted:
+        ``order_shift``, omega0 as fitted less omega0 with the excess's last term held at zero, and past
+        :data:`LAW_CONFLICT` ``held_shift``, omega0 less omega0 with the whole excess held at the ideal law;
+        the same where the cycles' envelope rises (:func:`.near.envelope_rises`: a mode beating in, which
+        the law learns as a frequency moving with the swing, within its prior). That difference is kept
+        whatever the conflict (``ideal_shift``): fits of one rig whose learned laws disagree hold it
+        (:func:`.pipeline._own_variances`).
 
         The first is the extrapolation's: a record whose swing spans a narrow range (a lightly damped
         rig from 1.2 rad to 1.05) gives the law's value, slope and curvature there so precisely that
@@ -322,51 +287,18 @@ class Model:
         the law's shape into 1.5e-3 of T0 (6-8 sigma of the covariance's, which only counts the
         noise); with one term fewer, where the record does determine the law, the two agree to a
         fraction of their sigma."""
-        self.held_shift = self.order_shift = self.ideal_shift = 0.0
         good = cyc.good & np.isfinite(cyc.phase)
-        if "ds" in self.names and not self.held:
-            fewer = copy.copy(self)  # _solve rebinds its results: the shallow copy keeps this fit's
-            fewer.terms = len(EXCESS_TERMS) - 1
-            fewer._solve(cyc, good)
-            self.order_shift = self.omega0 - fewer.omega0
-        self.rises = "ds" in self.names and envelope_rises(cyc.centre[good], cyc.fundamental[good])
-        if "ds" not in self.names or self.held:
-            return
-        held = copy.copy(self)
-        held.held = True
-        held._solve(cyc, good)
-        self.ideal_shift = self.omega0 - held.omega0
-        if self.conflict > LAW_CONFLICT or self.rises:
-            self.held_shift = self.ideal_shift
+        learned = "ds" in fit.names and not fit.held
+        rises = "ds" in fit.names and envelope_rises(cyc.centre[good], cyc.fundamental[good])
+        if not learned:
+            return replace(fit, order_shift=0.0, held_shift=0.0, ideal_shift=0.0, rises=rises)
+        fewer = self._solve(cyc, good, fit, free=len(EXCESS_TERMS) - 1)
+        ideal_shift = fit.omega0 - self._solve(cyc, good, fit, held=True).omega0
+        return replace(fit, order_shift=fit.omega0 - fewer.omega0, ideal_shift=ideal_shift, rises=rises,
+                       held_shift=ideal_shift if fit.conflict > LAW_CONFLICT or rises else 0.0)
 
-    def integral_at(self, tt: np.ndarray) -> np.ndarray:
-        """int dt / (R E D) from the reference time to ``tt`` (s), carried on at the end rates beyond the
-        first and last cycle: the phase is phi0 + omega0 times this."""
-        grid, cum, _, _, g0, g1 = self.phase_integral
-        return _carried(tt, grid, cum, g0, g1)
-
-    def law_integrals_at(self, tt: np.ndarray) -> np.ndarray:
-        """d :meth:`integral_at` / d p for each law parameter p (``names[2:]``), an (n, m) array."""
-        return np.column_stack([_carried(tt, *slope) for slope in self.law_slopes] or [np.zeros((len(tt), 0))])
-
-    def phase_at(self, tt: np.ndarray) -> np.ndarray:
-        """The fitted law's phase Phi at times ``tt`` (the cycles' fundamental is A cos Phi)."""
-        _, _, phi, omega, _, _ = self.phase_integral
-        return phi + omega * self.integral_at(tt)
-
-    def law_induced_variance(self) -> float:
-        """The variance of omega0 that the law's parameters carry (their own uncertainty, the record's and
-        the priors'): Sigma_wL Sigma_LL^-1 Sigma_Lw of the whole covariance, the part a fit holding the
-        law at its estimate does not see."""
-        law = [i for i, n in enumerate(self.names) if n in EXCESS_TERMS or n in ("kappa", "q")]
-        if not law:
-            return 0.0
-        cov = self.cov_stat + self.cov_law
-        cross = cov[1, law]
-        return float(cross @ np.linalg.pinv(cov[np.ix_(law, law)]) @ cross)
-
-    def jackknife(self, cyc: Cycles) -> tuple[float, int]:
-        """(variance of omega0, groups): the delete-a-group jackknife of this fit over up to
+    def jackknife(self, fit: PhaseFit, cyc: Cycles) -> tuple[float, int]:
+        """(variance of omega0, groups): the delete-a-group jackknife of ``fit`` over up to
         :data:`JACKKNIFE_GROUPS` contiguous groups of the good cycles, each refitted whole (waveform,
         envelope and phases). It sees every path by which a record's noise reaches omega0, those the
         covariance models (the phases, the envelope) and those it does not (noise correlated within
@@ -377,27 +309,53 @@ class Model:
         groups = min(JACKKNIFE_GROUPS, len(good))
         if groups < 5:
             return 0.0, 0
-        omegas = []
+        start = fit
         if self.law.kind != "linear":  # the refits' table: at their starting omega0, and room for
-            self._table(self.omega0, 1.2 * self._key[1])  # an envelope a little higher without a group
+            key, table = self._table(fit, fit.omega0, 1.2 * fit.table_key[1])  # an envelope a little higher
+            start = replace(fit, table_key=key, table=table)  # without a group
+        omegas = []
         for part in np.array_split(good, groups):
             keep = cyc.good & np.isfinite(cyc.phase)
             keep[part] = False
-            refit = copy.copy(self)  # _solve rebinds its results: the shallow copy keeps this fit's
-            refit.parent = self
-            refit._solve(cyc, keep)
-            omegas.append(refit.omega0)
+            omegas.append(self._solve(cyc, keep, start, parent=fit).omega0)
         omegas = np.array(omegas)
         return float((groups - 1) / groups * np.sum((omegas - omegas.mean()) ** 2)), groups
 
-    def local_omega(self, tt: np.ndarray) -> np.ndarray:
-        """The instantaneous frequency (rad/s) the fitted law gives at times ``tt``."""
-        return self.omega0 * self.rate_at(tt)
 
-    def local(self, tt: np.ndarray):
-        """(instantaneous frequency, d ln(amplitude) / dt) at times ``tt``: what the next pass's windows
-        are fitted with."""
-        return self.local_omega(tt), self.decay_at(tt)
+def unwrap(cyc: Cycles, good: np.ndarray) -> np.ndarray:
+    """The good cycles' phases made continuous: each one within pi of its predecessor advanced by
+    the local frequency over the time between them."""
+    centre, phase, omega = cyc.centre[good], cyc.phase[good], cyc.omega[good]
+    out = np.empty(len(phase))
+    out[0] = phase[0]
+    for k in range(1, len(phase)):
+        advance = 0.5 * (omega[k] + omega[k - 1]) * (centre[k] - centre[k - 1])
+        predicted = out[k - 1] + advance
+        out[k] = phase[k] + 2.0 * math.pi * round((predicted - phase[k]) / (2.0 * math.pi))
+    return out
+
+
+def _covariance(jd, jp, r, j_envelope, cov_envelope, excess: bool):
+    """(statistical, priors', T0's gain on the excess's priors): :mod:`.fit`, step 5. The statistical
+    part is the block sandwich (at least the white one) and what the envelope's own uncertainty adds (a
+    two-step estimate's correction, Murphy and Topel: H^-1 (J^T J_A) V_A (J_A^T J) H^-1, J_A the phases'
+    response to the envelope's coefficients); ``excess``: the law's excess terms are fitted (the first
+    rows after phi and omega)."""
+    hessian = jd.T @ jd + jp.T @ jp
+    # equilibrated before the inverse: the columns differ by ~1e3 in scale (phase, omega0 times the
+    # record's span, the excess times A^2), and at a nearly constant swing the direction only the
+    # priors fix has ~1e-10 of the largest curvature, which pinv's cut would otherwise round away
+    scale = 1.0 / np.sqrt(np.maximum(np.diag(hessian), 1e-300))
+    bread_inv = scale[:, None] * np.linalg.pinv(scale[:, None] * hessian * scale[None, :]) * scale[None, :]
+    stat_white, stat_sand, _ = white_and_blocks(jd, r, bread_inv)
+    cross = jd.T @ j_envelope
+    envelope = bread_inv @ cross @ cov_envelope @ cross.T @ bread_inv
+    cov_stat = (stat_sand if stat_sand[1, 1] > stat_white[1, 1] else stat_white) + envelope
+    cov_law = bread_inv @ (jp.T @ jp) @ bread_inv
+    # T0's response to the law's prior being off by one sigma in each of its excess terms (their rows
+    # come first): records of one rig share that error, while a proportional record's scale is its own
+    law_rows = len(EXCESS_TERMS) if excess else 0
+    return cov_stat, cov_law, (bread_inv @ jp.T)[1, :law_rows]
 
 
 class _Envelope:
@@ -516,13 +474,6 @@ def _from_reference(grid: np.ndarray, rate: np.ndarray, at_ref: float) -> np.nda
     """The trapezoidal integral of ``rate`` over ``grid``, zero at grid index ``at_ref`` (fractional)."""
     cum = np.concatenate([[0.0], np.cumsum(0.5 * (rate[1:] + rate[:-1]) * np.diff(grid))])
     return cum - float(np.interp(at_ref, np.arange(len(grid)), cum))
-
-
-def _carried(tt, grid, cum, g0, g1):
-    """The integral ``cum`` on ``grid`` at ``tt``, carried on at the end rates g0, g1 beyond it."""
-    inside = np.interp(tt, grid, cum)
-    inside = np.where(tt < grid[0], cum[0] + g0 * (tt - grid[0]), inside)
-    return np.where(tt > grid[-1], cum[-1] + g1 * (tt - grid[-1]), inside)
 
 
 def _waveform(a1: np.ndarray, peak_ratio: np.ndarray) -> np.ndarray:

@@ -18,7 +18,7 @@ import numpy as np
 from scipy.optimize import least_squares
 
 from .cycles import PERIODOGRAM_SAMPLES, Cycles, Samples, highest_harmonic, periodogram
-from .phase_law import Model
+from .phase_fit import PhaseFit
 from .read import MIN_CYCLES
 
 SECOND_MODE_POWER = 60.0  # peak / local median of the residual periodogram: noise peaks reach ~10-15
@@ -70,9 +70,9 @@ def outside(omega2: float, swept: tuple[float, float], span: float) -> bool:
     return not swept[0] - resolution < omega2 < swept[1] + resolution
 
 
-def swept_band(model: Model, centres: np.ndarray) -> tuple[float, float]:
+def swept_band(law_fit: PhaseFit, centres: np.ndarray) -> tuple[float, float]:
     """The lowest and highest frequency (rad/s) the first mode had at the cycles' ``centres`` (s)."""
-    local = model.local_omega(centres)
+    local = law_fit.local_omega(centres)
     return float(np.min(local)), float(np.max(local))
 
 
@@ -101,7 +101,7 @@ def _in_phase_harmonics(cyc: Cycles, good: np.ndarray) -> dict[int, np.ndarray]:
     return out
 
 
-def second_mode_of(rec: Samples, cyc: Cycles, baseline: np.ndarray, model: Model) -> Second | None:
+def second_mode_of(rec: Samples, cyc: Cycles, baseline: np.ndarray, law_fit: PhaseFit) -> Second | None:
     """:mod:`.fit`, step 3: a mode beating in, from the record minus the first mode as the law
     fitted it (its phase Phi(t), the cycles' fundamentals and odd harmonics between them: a swing that
     stays large has a third harmonic of ~1 % whose periodogram sidelobes, a few resolutions off it,
@@ -116,12 +116,12 @@ def second_mode_of(rec: Samples, cyc: Cycles, baseline: np.ndarray, model: Model
         return None
     idx = np.concatenate([cyc.index[k] for k in good])
     tau = rec.tau[idx]
-    phase = model.phase_at(tau)
+    phase = law_fit.phase_at(tau)
     rest = rec.y[idx] - baseline[idx]
     for n, amplitude in _in_phase_harmonics(cyc, good).items():
         rest = rest - np.interp(tau, cyc.centre[good], amplitude) * np.cos(n * phase)
     rest = rest - np.polyval(np.polyfit(tau, rest, 1), tau)
-    swept = swept_band(model, cyc.centre[good])
+    swept = swept_band(law_fit, cyc.centre[good])
     peak = peak_apart(tau, rest, swept)
     if peak is None:
         return None

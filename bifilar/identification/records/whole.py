@@ -18,7 +18,7 @@ from scipy.optimize import least_squares
 
 from .bound import Bound, cramer_rao
 from .cycles import Cycles, Samples, highest_harmonic
-from .phase_law import Model
+from .phase_fit import PhaseFit
 from .second_mode import SECOND_DECAY_SPANS, Second, outside, peak_apart, swept_band
 from .spread import block_length, few_blocks
 
@@ -41,8 +41,8 @@ class Whole:
     bound: Bound
 
 
-def fit_whole(rec: Samples, cyc: Cycles, model: Model, baseline: np.ndarray, second: Second | None) -> Whole:
-    """Every sample of the good cycles fitted at once, with the law's shape held as the cycles gave it:
+def fit_whole(rec: Samples, cyc: Cycles, law_fit: PhaseFit, baseline: np.ndarray, second: Second | None) -> Whole:
+    """Every sample of the good cycles fitted at once, with the law's shape held as the cycles gave it (``law_fit``):
 
         y - baseline = c0 + c1 u + E(t) [cos Phi + sum_{n=3,5} (E / E_mean)^(n-1) (a_n cos n Phi + b_n sin n Phi)]
                        + e^(-a2 tau) (c2 cos w2 tau + s2 sin w2 tau),
@@ -54,7 +54,7 @@ def fit_whole(rec: Samples, cyc: Cycles, model: Model, baseline: np.ndarray, sec
     phase law, one envelope and one second mode take all of it, the efficiency of a plain damped-sine
     least squares, while the law's chirp (from the cycles) keeps it right at large amplitude. The
     phase law's parameters other than phi0 and omega0 stay as the cycles fitted them; what their
-    uncertainty does to omega0 is added after (:meth:`.phase_law.Model.law_induced_variance`).
+    uncertainty does to omega0 is added after (:meth:`.phase_fit.PhaseFit.law_induced_variance`).
 
     Its uncertainty: the sandwich with the scores summed over each cycle, then over blocks of
     :data:`.spread.BLOCK_TAUS` integrated autocorrelation times of the omega0 score's cycle series, never
@@ -71,20 +71,20 @@ def fit_whole(rec: Samples, cyc: Cycles, model: Model, baseline: np.ndarray, sec
     y = rec.y[idx] - baseline[idx]
     span = max(tau[-1] - tau[0], 1e-300)
     u = (tau - 0.5 * (tau[0] + tau[-1])) / span
-    integral = model.integral_at(tau)
-    envelope = model.fund_at(tau) * (model.local_omega(tau) if rec.kind == "rate" else 1.0)
+    integral = law_fit.integral_at(tau)
+    envelope = law_fit.fund_at(tau) * (law_fit.local_omega(tau) if rec.kind == "rate" else 1.0)
     level = float(np.exp(np.mean(np.log(envelope))))
     harmonics = highest_harmonic(float(np.median([len(cyc.index[k]) for k in good])))
-    _, _, phi0, omega0, _, _ = model.phase_integral
+    _, _, phi0, omega0, _, _ = law_fit.phase_integral
     first = [phi0, omega0, math.log(float(np.median(cyc.fundamental[good])) / level), 0.0]
     largest = _SECOND_SHARE * float(np.max(envelope))
-    swept = swept_band(model, cyc.centre[good])
+    swept = swept_band(law_fit, cyc.centre[good])
 
     def plausible(f) -> bool:
         """Its second mode at most _SECOND_SHARE of the first (a law misfit near the first mode's
         frequency would pass for one of comparable size) and apart from the band the first mode swept
         (:func:`.second_mode.outside`)."""
-        scaled = tuple(w * f[0][1] / model.omega0 for w in swept)
+        scaled = tuple(w * f[0][1] / law_fit.omega0 for w in swept)
         return (math.hypot(*f[3][-2:]) * math.exp(-f[0][5] * tau[0]) <= largest
                 and outside(float(f[0][4]), scaled, span))
 
@@ -93,7 +93,7 @@ def fit_whole(rec: Samples, cyc: Cycles, model: Model, baseline: np.ndarray, sec
         second = None
         fit = _whole_fit(tau, y, u, integral, envelope, level, harmonics, first, None)
     if second is None:
-        peak = peak_apart(tau, fit[2], tuple(w * fit[0][1] / model.omega0 for w in swept))
+        peak = peak_apart(tau, fit[2], tuple(w * fit[0][1] / law_fit.omega0 for w in swept))
         if peak is not None:
             with_second = _whole_fit(tau, y, u, integral, envelope, level, harmonics, list(fit[0][:4]),
                                      Second(peak, 0.0, 0.0, 0.0))
@@ -118,8 +118,8 @@ def fit_whole(rec: Samples, cyc: Cycles, model: Model, baseline: np.ndarray, sec
     # the law's parameters, held here, in the bound with their priors: the fundamental's response to them
     # (the harmonics' and a rate's envelope's, a few % of it, left out)
     law = (np.exp(q[2] + q[3] * u) * envelope * np.sin(q[0] + q[1] * integral))[:, None] * q[1] \
-        * model.law_integrals_at(tau)
-    bound = cramer_rao(tau, r, jac, rec.step, 1, law, model.law_prior_sd)
+        * law_fit.law_integrals_at(tau)
+    bound = cramer_rao(tau, r, jac, rec.step, 1, law, law_fit.law_prior_sd)
     return Whole(float(q[1]), float(max(white[1, 1], sandwich[1, 1])), float(white[1, 1]), int(block), refined,
                  model_y + baseline[idx], idx, bound)
 
