@@ -54,7 +54,9 @@ def kernels_key(root: Path = Path(__file__).parent) -> str:
 # runs each, empty caches, /usr/bin/time), `validate all` cold in 78 s against 101 s at level 3; the
 # Kane rhs runs 3-5 % slower (benchmarks/kane.py: 2.33-2.40e5 against 2.41-2.50e5 evaluations/s, two
 # interleaved rounds) and the sweep as fast (1.82-1.85e3 configurations/s/core against 1.83-1.86e3). A
-# first run compiles every kernel; the warm ones spend most of their time in MuJoCo and scipy.
+# first run compiles every kernel; the warm ones spend most of their time in MuJoCo and scipy. What each
+# group of kernels costs to compile: benchmarks/compile_cpu.py (CPU s in a fresh cache; the Kane group
+# 21.7 s, 25.8 before its cross products were written out and its accelerations kernel dropped).
 OPT_LEVEL = "1"
 
 

@@ -1,11 +1,19 @@
 """Products and solves of small dense matrices inside numba-compiled kernels.
 
 numba hands ``@`` and ``np.linalg.solve`` to BLAS/LAPACK, whose call overhead (~1 us) dwarfs the
-arithmetic of a 3x5 or 5x5 problem; plain loops compile to a few nanoseconds.
+arithmetic of a 3x5 or 5x5 problem; plain loops compile to a few nanoseconds. Likewise numba's
+``np.cross`` is generic (any shapes, broadcast along an axis) and costs more to compile than the three
+products it computes for two 3-vectors: :func:`cross` writes them out, with the same arithmetic.
 """
 
 import numpy as np
 from numba import njit
+
+
+@njit(cache=True)
+def cross(a, b):
+    """a x b of two 3-vectors, written out (the same products and order as ``np.cross``)."""
+    return np.array([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
 
 
 @njit(cache=True)

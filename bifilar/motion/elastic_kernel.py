@@ -21,7 +21,8 @@ from numba import njit
 
 from bifilar.motion.kane_kernel import P_AIR as AIR_FLAG
 from bifilar.motion.kane_kernel import air_terms
-from bifilar.motion.nwire_kernel import STATE_SIZE, _cross, quat_matrix, state_rate
+from bifilar.motion.nwire_kernel import STATE_SIZE, quat_matrix, state_rate
+from bifilar.smallmat import cross as _cross
 
 
 @njit(cache=True)

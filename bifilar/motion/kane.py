@@ -19,6 +19,7 @@ from bifilar.rig.air import added_mass, drag_parameters
 from bifilar.motion import kane_kernel as K
 from bifilar.rig import Rig, RigError
 from bifilar.rig.statics import State
+from bifilar.smallmat import solve
 
 POLAR, TILT = K.POLAR, K.TILT
 
@@ -101,7 +102,8 @@ class KaneModel:
         return K.eom(_vec(theta), _vec(dtheta), self.p, chart)
 
     def accelerations(self, theta, dtheta, chart=POLAR) -> np.ndarray:
-        return K.accelerations(_vec(theta), _vec(dtheta), self.p, chart)
+        """theta'' from M5 theta'' = N5, solved as the compiled rhs solves it."""
+        return solve(*self.eom(theta, dtheta, chart))
 
     def constraint(self, theta, chart=POLAR) -> float:
         """g(theta) - a of (5.1.2): |AD|^2 - l'^2, m^2."""

@@ -38,6 +38,7 @@ from numba import njit
 
 from bifilar.rig.air import drag_wrench
 from bifilar.jit import announce_compile
+from bifilar.smallmat import cross as _cross
 from bifilar.smallmat import mm as _mm
 from bifilar.smallmat import mv as _mv
 from bifilar.smallmat import solve as _solve
@@ -125,9 +126,9 @@ def kinematics(th, dth, p, chart):
     V[:, 1] = l * u2
     V[:, 2] = l * u3
     for i in range(5):
-        V[:, i] += np.cross(G[:, i], r)
+        V[:, i] += _cross(G[:, i], r)
     ubias = u22 * dth[1] ** 2 + 2.0 * u23 * dth[1] * dth[2] + u33 * dth[2] ** 2
-    vbias = l * ubias + np.cross(wbias, r) + np.cross(omega, np.cross(omega, r))
+    vbias = l * ubias + _cross(wbias, r) + _cross(omega, _cross(omega, r))
     # Loop closure: d = AD = AB + l u + CD, CD = -b' n~3.
     d = p[8:11] + l * u - bp * n3t
     J = np.zeros((3, 5))
@@ -136,7 +137,7 @@ def kinematics(th, dth, p, chart):
     J[:, 3] = -bp * n3t_4
     J[:, 4] = -bp * n3t_5
     # d2(n~3)/dt2 at zero theta'': n~3 is body-fixed, so it is wbias x n~3 + omega x (omega x n~3).
-    n3t_bias = np.cross(wbias, n3t) + np.cross(omega, np.cross(omega, n3t))
+    n3t_bias = _cross(wbias, n3t) + _cross(omega, _cross(omega, n3t))
     dbias = l * ubias - bp * n3t_bias
     return u, R, r, V, G, vbias, wbias, d, J, dbias
 
@@ -160,16 +161,16 @@ def air_terms(R, v, omega, p):
     x = np.concatenate((v, omega))
     h = _mv(maw, x)  # [P; L]
     spin = np.zeros(6)
-    spin[:3] = np.cross(omega, v)
+    spin[:3] = _cross(omega, v)
     b = -_mv(maw, spin)  # d(M_A,w)/dt x = Omega M_A,w x - M_A,w Omega x
-    b[:3] += np.cross(omega, h[:3])
-    b[3:] += np.cross(omega, h[3:]) + np.cross(v, h[:3])
+    b[:3] += _cross(omega, h[:3])
+    b[3:] += _cross(omega, h[3:]) + _cross(v, h[:3])
     axes = _mm(R, p[63:72].copy().reshape((3, 3)))
     c = _mv(R, p[60:63].copy())
-    f_e, g_e = drag_wrench(_mv(axes.T.copy(), v + np.cross(omega, c)), _mv(axes.T.copy(), omega), p[72:80])
+    f_e, g_e = drag_wrench(_mv(axes.T.copy(), v + _cross(omega, c)), _mv(axes.T.copy(), omega), p[72:80])
     drag = np.empty(6)
     drag[:3] = _mv(axes, f_e)
-    drag[3:] = _mv(axes, g_e) + np.cross(c, drag[:3])
+    drag[3:] = _mv(axes, g_e) + _cross(c, drag[:3])
     return maw, b, drag
 
 
@@ -182,8 +183,12 @@ def eom(th, dth, p, chart):
     beta = 2.0 * _mv(J.T.copy(), d)  # (5.1.3)
     gamma = -beta[:4] / beta[4]  # (5.1.4)
     # Partial velocities with theta5' eliminated: V_new (5.1.21), G_new (5.1.19).
-    Vn = V[:, :4] + np.outer(V[:, 4], gamma)
-    Gn = G[:, :4] + np.outer(G[:, 4], gamma)
+    Vn = V[:, :4].copy()
+    Gn = G[:, :4].copy()
+    for i in range(3):
+        for j in range(4):
+            Vn[i, j] += V[i, 4] * gamma[j]
+            Gn[i, j] += G[i, 4] * gamma[j]
     Iw = inertia_world(R, p)
     omega = _mv(G, dth)
     M5 = np.empty((5, 5))
@@ -192,7 +197,7 @@ def eom(th, dth, p, chart):
     M5[:4, :] = m * _mm(VnT, V) + _mm(GnT, _mm(Iw, G))
     weight = np.array([0.0, 0.0, m * g])
     Iw_omega = _mv(Iw, omega)
-    N5[:4] = -_mv(VnT, m * vbias + weight) - _mv(GnT, _mv(Iw, wbias) + np.cross(omega, Iw_omega))
+    N5[:4] = -_mv(VnT, m * vbias + weight) - _mv(GnT, _mv(Iw, wbias) + _cross(omega, Iw_omega))
     if p[P_AIR] != 0.0:
         maw, b, drag = air_terms(R, _mv(V, dth), omega, p)
         P6 = np.vstack((V, G))
@@ -206,18 +211,12 @@ def eom(th, dth, p, chart):
 
 
 @njit(cache=True)
-def accelerations(th, dth, p, chart):
-    """theta'' from M5 theta'' = N5."""
-    M5, N5 = eom(th, dth, p, chart)
-    return _solve(M5, N5)
-
-
-@njit(cache=True)
 def rhs(y, p, chart):
-    """First-order form y = (theta, theta') -> y'."""
+    """First-order form y = (theta, theta') -> y', theta'' from M5 theta'' = N5 (:func:`eom`)."""
+    M5, N5 = eom(y[:5], y[5:], p, chart)
     out = np.empty(10)
     out[:5] = y[5:]
-    out[5:] = accelerations(y[:5], y[5:], p, chart)
+    out[5:] = _solve(M5, N5)
     return out
 
 
@@ -241,7 +240,8 @@ def loads(th, dth, p, chart):
     acceleration and angular acceleration (world frame) and the residual of the fit (N).
     """
     u, R, r, V, G, vbias, wbias, d, J, dbias = kinematics(th, dth, p, chart)
-    dd = accelerations(th, dth, p, chart)
+    M5, N5 = eom(th, dth, p, chart)
+    dd = _solve(M5, N5)
     m, g, bp = p[P_M], p[P_G], p[P_BP]
     acc = _mv(V, dd) + vbias
     alpha = _mv(G, dd) + wbias
@@ -254,11 +254,11 @@ def loads(th, dth, p, chart):
     A = np.empty((6, 2))
     A[:3, 0] = e1
     A[:3, 1] = e2
-    A[3:, 0] = np.cross(arm_c, e1) / bp
-    A[3:, 1] = np.cross(arm_d, e2) / bp
+    A[3:, 0] = _cross(arm_c, e1) / bp
+    A[3:, 1] = _cross(arm_d, e2) / bp
     rhs_ = np.empty(6)
     rhs_[:3] = m * acc + np.array([0.0, 0.0, m * g])
-    rhs_[3:] = _mv(Iw, alpha) + np.cross(omega, _mv(Iw, omega))
+    rhs_[3:] = _mv(Iw, alpha) + _cross(omega, _mv(Iw, omega))
     if p[P_AIR] != 0.0:  # the wires carry what the air does not: minus the fluid's wrench
         maw, b, drag = air_terms(R, _mv(V, dth), omega, p)
         rhs_ += _mv(maw, np.concatenate((acc, alpha))) + b - drag

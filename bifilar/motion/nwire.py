@@ -78,7 +78,7 @@ class NWireModel:
         return float(max(self.lengths.max(), 1e-3))
 
     def tensions(self, y: np.ndarray) -> np.ndarray:
-        return NK.tensions(np.ascontiguousarray(y, dtype=float), *self.args)
+        return NK.dynamics(np.ascontiguousarray(y, dtype=float), *self.args)[1]
 
 
 @dataclass(frozen=True)
@@ -196,7 +196,7 @@ def _simulate_elastic(model: NWireModel, y: np.ndarray, grid: np.ndarray, rtol: 
 
 def _slack_event(args, wire: int):
     def event(t, y):
-        return NK.tensions(y, *args)[wire]
+        return NK.dynamics(y, *args)[1][wire]
     event.terminal, event.direction = True, -1
     return event
 

@@ -22,6 +22,7 @@ from numba import njit
 
 from bifilar.motion.kane_kernel import P_AIR as AIR_FLAG
 from bifilar.motion.kane_kernel import air_terms
+from bifilar.smallmat import cross as _cross
 
 STATE_SIZE = 13
 
@@ -62,14 +63,10 @@ def matrix_quat(rot):
 
 
 @njit(cache=True)
-def _cross(a, b):
-    return np.array([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
-
-
-@njit(cache=True)
 def dynamics(y, arms, anchors, inertia_body, mass, gravity, air):
     """(nu', tensions, J, rho): accelerations (v', omega'), wire tensions (N, positive pulling),
-    the constraint Jacobian (N x 6) and the anchor-attachment distances (m) at state y.
+    the constraint Jacobian (N x 6) and the anchor-attachment distances (m) at state y. Also the
+    tensions' kernel for Python and the sweep (``dynamics(...)[1]``): one kernel fewer to compile.
 
     ``air``: the Kane kernel's parameter vector with its air entries filled in the rig's body frame
     (:func:`bifilar.motion.kane.air_vector`); with air the fluid's added mass M_A,w joins the mass
@@ -178,12 +175,6 @@ def state_rate(y, acc):
     dy[6] = 0.5 * (om[0] * q[2] - om[1] * q[1] + om[2] * q[0])
     dy[7:13] = acc
     return dy
-
-
-@njit(cache=True)
-def tensions(y, arms, anchors, inertia_body, mass, gravity, air):
-    """Wire tensions (N) at state y."""
-    return dynamics(y, arms, anchors, inertia_body, mass, gravity, air)[1]
 
 
 @njit(cache=True)

@@ -85,10 +85,10 @@ def peak_tension(com, rot, shapes, omegas, springs, base, arms, anchors, inertia
             stretch = springs * np.abs(NK.dynamics_jacobian(y, arms, anchors) @ shapes[k])
             peak = max(peak, (base + stretch).max())
             continue
-        peak = max(peak, NK.tensions(y, arms, anchors, inertia, mass, gravity, air).max())
+        peak = max(peak, NK.dynamics(y, arms, anchors, inertia, mass, gravity, air)[1].max())
         for sign in (1.0, -1.0):
             y[:3] = com + sign * shapes[k, :3]
             y[3:7] = NK.matrix_quat(pose_kernel.rotation_vector_matrix(sign * shapes[k, 3:]) @ rot)
             y[7:13] = 0.0
-            peak = max(peak, NK.tensions(y, arms, anchors, inertia, mass, gravity, air).max())
+            peak = max(peak, NK.dynamics(y, arms, anchors, inertia, mass, gravity, air)[1].max())
     return peak
