@@ -1,87 +1,100 @@
-"""CPU seconds numba spends compiling each group of kernels, each group in a fresh, empty cache.
+"""CPU seconds numba spends compiling the project's kernels (:data:`bifilar.kernels.GROUPS`), in fresh,
+empty caches: the figures the table's costs and the first run's sharing of the compiling come from.
 
-A first run's extra time (``validate all`` cold against warm) is mostly numba compiling; this script
-puts a figure on each group so a change to the kernels can be judged by what it saves. Each group's
-entry kernels (the ones Python calls) are compiled for the signatures the suite uses, in a subprocess
-with a new temporary NUMBA_CACHE_DIR, at :data:`bifilar.jit.OPT_LEVEL`; the figure is that process's CPU
-time spent in ``compile`` (numba compiles on one thread), so it is steadier than wall time on a busy
-machine. The code measured is this checkout's (the subprocess's PYTHONPATH is the script's repository, not
-an installed copy). A group's figure includes the callees it compiles (the sweep compiles pose and N-wire
-kernels), so the groups overlap; ``all`` compiles every group in one process, as a first run does.
+A first run's extra time (``validate all`` cold against warm) is mostly numba compiling. Three views:
 
-    python benchmarks/compile_cpu.py              # every group, then all
-    python benchmarks/compile_cpu.py kane pose    # the named groups only
+    python benchmarks/compile_cpu.py               # each group in the table's order, in one process:
+                                                   # what it costs once the groups before it are cached
+    python benchmarks/compile_cpu.py shares 2      # 2 processes side by side on one cache, each its share
+                                                   # (bifilar.kernels.shares): each one's CPU and wall time
+    python benchmarks/compile_cpu.py --read CACHE  # the kernels and signatures a cache folder holds (a
+                                                   # cold run's NUMBA_CACHE_DIR): what the table must list
+
+CPU time of the compiling process (numba compiles on one thread) is steadier than wall time on a busy
+machine. The code measured is this checkout's (the subprocesses' PYTHONPATH is the script's repository,
+not an installed copy), at :data:`bifilar.jit.OPT_LEVEL`.
 """
 
 from __future__ import annotations
 
-import importlib
 import os
+import pickle
 import subprocess
 import sys
 import tempfile
+import time
 from pathlib import Path
 
-# Signatures as the suite calls them: a1/a2/a3 C-contiguous float64 arrays, f float64, i int64.
-GROUPS = {
-    "kane": [("bifilar.motion.kane_kernel", name, sig) for name, sig in [
-        ("rhs", "a1 a1 i"), ("observe", "a2 a1 i"), ("loads", "a1 a1 a1 i"), ("eom", "a1 a1 a1 i"),
-        ("pose", "a1 a1 i")]],
-    "nwire": [("bifilar.motion.nwire_kernel", name, sig) for name, sig in [
-        ("rhs", "a1 a2 a2 a2 f f a1"), ("observe", "a2 a2 a2 a2 f f a1"), ("dynamics", "a1 a2 a2 a2 f f a1"),
-        ("quat_matrix", "a1"), ("dynamics_jacobian", "a1 a2 a2")]],
-    "elastic": [("bifilar.motion.elastic_kernel", name, sig) for name, sig in [
-        ("rhs", "a1 a2 a2 a1 a1 a2 f f a1"), ("observe", "a2 a2 a2 a1 a1 a2 f f a1")]],
-    "pose": [("bifilar.rig.pose_kernel", name, sig) for name, sig in [
-        ("newton_equilibrium", "a1 a2 a1 a2 a2 a1 f f i"), ("reduced_matrices", "a1 a2 a1 a2 a2 a2 f f f"),
-        ("equilibrium_balance", "a1 a2 a1 a2 a2 a1 f f")]],
-    "slopes": [("bifilar.identification.slopes_kernel", "period_slopes", "a1 a1 i f f a1 a2 a1 a3 a2 a2 a3")],
-    "sweep": [("bifilar.sweep.kernel", "continued_modes", "a2 a2 a1 f f a2 f a1 a2 a1 f f f f"),
-              ("bifilar.sweep.kernel", "peak_tension", "a1 a2 a2 a1 a1 a1 a2 a2 a2 f f a1")],
-}
+ROOT = Path(__file__).resolve().parents[1]
 
 
-def _types(sig: str) -> tuple:
-    from numba import types
+def in_process(names: list[str]) -> None:
+    """Compile the named groups here, one after the other; print each group's CPU seconds, then the
+    process's wall seconds."""
+    from bifilar import kernels
 
-    names = {"a1": types.float64[::1], "a2": types.float64[:, ::1], "a3": types.float64[:, :, ::1],
-             "f": types.float64, "i": types.int64}
-    return tuple(names[s] for s in sig.split())
-
-
-def compile_groups(names: list[str]) -> float:
-    """CPU seconds to compile the named groups' kernels in this process."""
-    import bifilar  # noqa: F401  (sets NUMBA_OPT before numba is imported)
-
-    start = os.times()
+    start = time.perf_counter()
     for name in names:
-        for module, kernel, sig in GROUPS[name]:
-            getattr(importlib.import_module(module), kernel).compile(_types(sig))
-    end = os.times()
-    return (end.user - start.user) + (end.system - start.system)
+        before = os.times()
+        kernels.precompile([name])
+        after = os.times()
+        print(f"{name} {after.user - before.user + after.system - before.system:.2f}", flush=True)
+    print(f"wall {time.perf_counter() - start:.2f}")
 
 
-def measure(names: list[str]) -> float:
-    """:func:`compile_groups` in a subprocess with an empty cache of its own."""
+def _start(names: list[str], cache: str) -> subprocess.Popen:
+    env = dict(os.environ, NUMBA_CACHE_DIR=cache, PYTHONPATH=str(ROOT))
+    return subprocess.Popen([sys.executable, __file__, "--in-process", *names], env=env, stdout=subprocess.PIPE,
+                            text=True)
+
+
+def _figures(out: str) -> dict[str, float]:
+    return {name: float(value) for name, value in (line.split() for line in out.splitlines())}
+
+
+def in_order() -> None:
+    from bifilar.kernels import GROUPS
+
     with tempfile.TemporaryDirectory(prefix="numba-compile-cpu-") as cache:
-        env = dict(os.environ, NUMBA_CACHE_DIR=cache, PYTHONPATH=str(Path(__file__).resolve().parents[1]))
-        run = subprocess.run([sys.executable, __file__, "--in-process", *names], env=env,
-                             capture_output=True, text=True, check=True)
-    return float(run.stdout.split()[-1])
+        figures = _figures(_start(list(GROUPS), cache).communicate()[0])
+    print("group     cpu s  (table's cost)")
+    for name, group in GROUPS.items():
+        print(f"{name:<8} {figures[name]:6.1f}  ({group.cost:g})")
+    print(f"{'all':<8} {sum(v for k, v in figures.items() if k != 'wall'):6.1f}  ({figures['wall']:.1f} s wall)")
 
 
-def main(names: list[str]) -> None:
-    for name in names or list(GROUPS):
-        print(f"{name:<8} {measure([name]):6.1f} s cpu", flush=True)
-    if not names:
-        print(f"{'all':<8} {measure(list(GROUPS)):6.1f} s cpu")
+def side_by_side(n: int) -> None:
+    from bifilar.kernels import shares
+
+    with tempfile.TemporaryDirectory(prefix="numba-compile-cpu-") as cache:
+        runs = [(share, _start(share, cache)) for share in shares(n)]
+        results = [(share, _figures(proc.communicate()[0])) for share, proc in runs]
+    print("share  cpu s  wall s  groups")
+    for i, (share, figures) in enumerate(results):
+        cpu = sum(figures[g] for g in share)
+        print(f"{i:<5} {cpu:6.1f}  {figures['wall']:6.1f}  {' '.join(f'{g} {figures[g]:.1f}' for g in share)}")
+
+
+def read(cache: str) -> None:
+    """Every kernel and signature in ``cache``'s index files (numba's own format: a pickled version,
+    then the pickled (stamp, overloads) whose keys start with the signature)."""
+    for index in sorted(Path(cache).rglob("*.nbi")):
+        with open(index, "rb") as f:
+            pickle.load(f)
+            _, overloads = pickle.loads(f.read())
+        for key in overloads:
+            print(index.name.split(".py")[0], ", ".join(str(t) for t in key[0]))
 
 
 if __name__ == "__main__":
-    if sys.argv[1:2] == ["--in-process"]:
-        print(f"{compile_groups(sys.argv[2:]):.2f}")
+    args = sys.argv[1:]
+    if args[:1] == ["--in-process"]:
+        in_process(args[1:])
+    elif args[:1] == ["--read"] and len(args) == 2:
+        read(args[1])
+    elif args[:1] == ["shares"] and len(args) == 2 and args[1].isdigit():
+        side_by_side(int(args[1]))
+    elif not args:
+        in_order()
     else:
-        unknown = [n for n in sys.argv[1:] if n not in GROUPS]
-        if unknown:
-            sys.exit(f"usage: python benchmarks/compile_cpu.py [{' | '.join(GROUPS)}]...; unknown {unknown}")
-        main(sys.argv[1:])
+        sys.exit("usage: python benchmarks/compile_cpu.py [shares N | --read CACHE]")

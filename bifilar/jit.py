@@ -6,8 +6,8 @@ its cache into ``__pycache__`` beside the sources (which fails silently in a rea
 litters a checkout); :func:`use_user_cache` points it at the user's cache folder instead (one
 subfolder per state of the kernels' sources: :func:`kernels_key`), unless ``NUMBA_CACHE_DIR`` is already set, and compiles at LLVM's level 1 (:data:`OPT_LEVEL`). The first run
 after an install or a change of a kernel compiles for 30-80 s; :func:`announce_compile` says so in one
-line instead of leaving the user in silence, and the suite runs the cases that compile first, one
-worker each (:data:`validate.registry.COMPILES`).
+line instead of leaving the user in silence, and a run on several processes shares the compiling out
+between them, none compiling a kernel twice (:mod:`bifilar.kernels`).
 
 One-shot work (one rig's rest pose and modes) need not wait for a compiler: :class:`LoopKernels`
 runs a kernel module's functions as plain Python (numpy) until they are either cached on disk or
@@ -77,7 +77,7 @@ def announce_compile(what: str, *kernels, seconds: str = "30-80") -> None:
     note would repeat it per worker) if any of ``kernels`` (numba dispatchers with ``cache=True``) has
     no fresh cache entry, i.e. will be compiled at its first call. Call it just before the kernels'
     first use (it reads a small index file per kernel). ``seconds``: the estimate, on 2 cores."""
-    if _first(what) and any(not _cached(k) for k in kernels):
+    if _first(what) and any(not cached(k) for k in kernels):
         _note(what, seconds)
 
 
@@ -85,7 +85,7 @@ def announce_modules(what: str, modules, seconds: str) -> bool:
     """One note for every kernel of ``modules`` (see :func:`announce_compile`), after which no other
     note is printed in this process: for a command that will use them all (``validate all``). Whether
     any of them will compile."""
-    cold = not all(_cached(k) for m in modules for k in _dispatchers(m).values())
+    cold = not all(cached(k) for m in modules for k in _dispatchers(m).values())
     if _first(what) and cold:
         _note(what, seconds)
     _announced.add(EVERYTHING)
@@ -132,7 +132,7 @@ class LoopKernels:
 
     def __getattr__(self, name: str):
         if self._compiled is None:
-            self._compiled = all(_cached(k) for k in _dispatchers(self._module).values())
+            self._compiled = all(cached(k) for k in _dispatchers(self._module).values())
         if not self._compiled:
             self._calls += 1
             if self._calls <= LOOP_CALLS:
@@ -162,7 +162,8 @@ def interpreted(module: types.ModuleType) -> types.ModuleType:
     return twin
 
 
-def _cached(kernel) -> bool:
+def cached(kernel) -> bool:
+    """Whether numba dispatcher ``kernel`` (``cache=True``) has an entry in the on-disk cache."""
     try:
         return bool(kernel._cache._cache_file._load_index())
     except Exception:  # numba internals moved: assume cached rather than print a wrong note

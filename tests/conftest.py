@@ -19,6 +19,11 @@ The long tiers, ``fuzz`` and ``long``, run only when asked for by name (``-m fuz
 (the quick tier's ``-m "not slow"``, which replaces any ``-m`` of the default options) still leaves them
 out.
 
+On an empty numba cache each pytest-xdist worker first compiles its share of the kernels
+(:func:`bifilar.kernels.shares`) and loads the others' from the cache as its tests meet them: left to
+compile at first use, the two workers met the same kernels at about the same time and both compiled
+them. A run without workers compiles at first use, as before.
+
 One BLAS thread per test worker, as ``python -m validate`` sets it (``validate/__main__.py``): set here,
 before anything imports numpy, so that pytest's two workers do not each run OpenBLAS's threads on the two
 cores.
@@ -37,7 +42,7 @@ from hypothesis import HealthCheck, settings  # noqa: E402
 
 sys.path.insert(0, str(Path(__file__).parent))  # helper modules beside the tests (thesis_appendix)
 
-from bifilar import jit  # noqa: E402
+from bifilar import jit, kernels  # noqa: E402
 from bifilar.motion.kane import KaneModel  # noqa: E402
 from validate.assets import rig  # noqa: E402
 
@@ -48,6 +53,13 @@ _QUIET = [HealthCheck.filter_too_much, HealthCheck.too_slow, HealthCheck.data_to
 settings.register_profile("ci", derandomize=True, database=None, deadline=None, suppress_health_check=_QUIET)
 settings.register_profile("fuzz", derandomize=False, database=None, deadline=None, suppress_health_check=_QUIET)
 settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "ci"))
+
+
+def pytest_sessionstart(session):
+    worker = os.environ.get("PYTEST_XDIST_WORKER", "")  # gw0, gw1, ...: a worker of -n N (module docstring)
+    if worker.startswith("gw") and kernels.cold():
+        count = int(os.environ.get("PYTEST_XDIST_WORKER_COUNT", "1"))
+        kernels.precompile(kernels.shares(count)[int(worker[2:]) % count])
 
 
 LONG_TIERS = ("fuzz", "long")

@@ -43,7 +43,7 @@ def test_the_twin_is_python_and_agrees_with_the_compiled_kernels():
 
 def test_loop_kernels_interpret_until_they_loop(monkeypatch, capsys):
     kernels = jit.LoopKernels(pose_kernel, "the test's kernels", seconds="1")
-    monkeypatch.setattr(jit, "_cached", lambda kernel: False)  # as on a fresh machine
+    monkeypatch.setattr(jit, "cached", lambda kernel: False)  # as on a fresh machine
     monkeypatch.setattr(jit, "_announced", set())
     monkeypatch.setattr(jit, "LOOP_CALLS", 3)
     seen = [kernels.cross_matrix for _ in range(5)]
@@ -53,12 +53,12 @@ def test_loop_kernels_interpret_until_they_loop(monkeypatch, capsys):
 
 
 def test_cached_kernels_are_used_compiled(monkeypatch):
-    monkeypatch.setattr(jit, "_cached", lambda kernel: True)
+    monkeypatch.setattr(jit, "cached", lambda kernel: True)
     assert jit.LoopKernels(pose_kernel, "x", "1").cross_matrix is pose_kernel.cross_matrix
 
 
 def test_one_note_for_everything(monkeypatch, capsys):
-    monkeypatch.setattr(jit, "_cached", lambda kernel: False)
+    monkeypatch.setattr(jit, "cached", lambda kernel: False)
     monkeypatch.setattr(jit, "_announced", set())
     jit.announce_modules("all the kernels", [pose_kernel], seconds="5-10")
     jit.announce_compile("the Kane kernels", pose_kernel.cross_matrix)
@@ -78,7 +78,7 @@ def test_modes_from_the_twin_match_the_compiled_kernels(name, monkeypatch):
         monkeypatch.setattr(statics, "_memo", {})  # the rest pose searched afresh by each
         monkeypatch.setattr(statics, "PK", jit.LoopKernels(pose_kernel, "x", "1"))
         monkeypatch.setattr("bifilar.motion.modes.PK", statics.PK)
-        monkeypatch.setattr(jit, "_cached", lambda kernel, c=cached: c)
+        monkeypatch.setattr(jit, "cached", lambda kernel, c=cached: c)
         both.append(sorted(m.omega2 for m in linearize(r).modes))
     np.testing.assert_allclose(both[0], both[1], rtol=1e-10)  # eigenvalues of the same matrices to rounding
 
@@ -98,25 +98,68 @@ def _logged_case(name, keep, traces):
 _ORDER_LOG = ""
 
 
+def _logged_share(groups):
+    """A stand-in for kernels.precompile (inherited by the forked workers): when each share starts and ends."""
+    with open(_ORDER_LOG, "a") as out:
+        out.write(f"start share:{','.join(groups)}\n")
+    time.sleep(0.05)
+    with open(_ORDER_LOG, "a") as out:
+        out.write(f"end share:{','.join(groups)}\n")
+
+
 @pytest.mark.parametrize("cold", [True, False])
-def test_on_an_empty_cache_the_compiling_cases_run_first(cold, monkeypatch, tmp_path):
-    # started together, both workers compiled the same kernels (the first validate all 2.7x a warm one);
-    # on an empty cache the cases tagged COMPILES run first and every other case after the last of them
+def test_on_an_empty_cache_each_worker_compiles_a_share_before_the_cases(cold, monkeypatch, tmp_path):
+    # started together on the cases, both workers compiled the same kernels (the first validate all 2.7x
+    # a warm one); on an empty cache each worker compiles one share of the kernels, then the cases run
+    from bifilar import kernels
     from validate import suite
-    from validate.registry import COMPILES
 
     monkeypatch.setattr(sys.modules[__name__], "_ORDER_LOG", str(tmp_path / "order"))
     monkeypatch.setattr(suite, "run_case", _logged_case)
+    monkeypatch.setattr(kernels, "precompile", _logged_share)
     monkeypatch.setattr(suite, "_announce_compile", lambda: cold)
     cases = suite.registered()
-    compiling = {c.name for c in cases if COMPILES in c.tags}
-    assert {"air-torsion-period-shift", "boat-study", "elastic-quadrifilar-closed-form"} <= compiling
     assert suite.run_cases(cases, jobs=2) == 0
     lines = [line.split() for line in (tmp_path / "order").read_text().splitlines()]
-    assert sorted(n for what, n in lines if what == "end") == sorted(c.name for c in cases)
-    last_compiling = max(i for i, (what, n) in enumerate(lines) if what == "end" and n in compiling)
-    first_other = min(i for i, (what, n) in enumerate(lines) if what == "start" and n not in compiling)
-    assert (last_compiling < first_other) == cold  # warm: the cases in their order, two at a time
+    assert sorted(n for what, n in lines if what == "end" and not n.startswith("share:")) == sorted(c.name for c in cases)
+    shares = [n for what, n in lines if what == "end" and n.startswith("share:")]
+    if not cold:
+        assert shares == []  # warm: the cases in their order, two at a time
+        return
+    assert sorted(shares) == sorted("share:" + ",".join(s) for s in kernels.shares(2))
+    starts = [i for i, (what, n) in enumerate(lines) if what == "start" and n.startswith("share:")]
+    assert lines[starts[1]][0] == "start" and starts[1] < min(i for i, (w, n) in enumerate(lines) if w == "end")
+    last_share = max(i for i, (what, n) in enumerate(lines) if what == "end" and n.startswith("share:"))
+    first_case = min(i for i, (what, n) in enumerate(lines) if what == "start" and not n.startswith("share:"))
+    assert last_share < first_case
+
+
+def test_the_shares_cover_every_group_once_and_balance():
+    from bifilar import kernels
+
+    for n in (1, 2, 3, 5):
+        dealt = kernels.shares(n)
+        assert sorted(g for share in dealt for g in share) == sorted(kernels.GROUPS)
+        costs = [sum(kernels.GROUPS[g].cost for g in share) for share in dealt]
+        # greedy to the least loaded: no share exceeds another by more than the costliest group
+        assert max(costs) - min(costs) <= max(g.cost for g in kernels.GROUPS.values())
+
+
+def test_the_table_names_every_cached_kernel_of_the_project():
+    """A kernel the table leaves out compiles at first use in every worker that meets it: each module
+    with cached kernels is a group, and each of its kernels is listed or only ever a callee."""
+    import importlib
+
+    from bifilar import kernels
+
+    project = Path(__file__).resolve().parents[1] / "bifilar"
+    modules = {".".join(p.relative_to(project.parent).with_suffix("").parts) for p in project.rglob("*.py")
+               if "cache=True" in p.read_text()} - {"bifilar.jit", "bifilar.smallmat", "bifilar.rig.air"}
+    assert modules == {g.module for g in kernels.GROUPS.values()}
+    for group in kernels.GROUPS.values():
+        module = importlib.import_module(group.module)
+        for name in group.kernels:
+            assert hasattr(getattr(module, name), "compile"), f"{group.module}.{name} is no numba kernel"
 
 
 @pytest.mark.slow

@@ -64,16 +64,6 @@ class Case:
 REGISTRY: dict[str, Case] = {}
 
 
-# The tag of the cases that, on an empty cache, compile most of the kernels (the Kane kernels; the pose,
-# modes, slopes and sweep kernels; the elastic ones; the TMT ones: 34, 45, 9 and 6 s of the 99 s of
-# compiling, numba's compile events counted per case, 2 busy cores). The suite runs them first, one
-# worker each, and the rest after them (:func:`validate.suite.run_cases`): started together, every
-# worker compiled the same kernels. The N-wire integrator's rhs and observe are among them (the
-# nwire-vs-kane-tseng case): left to the tensor cases, which run side by side late in the suite, both
-# workers compiled them at once (~5 s each on a quiet machine).
-COMPILES = "compiles"
-
-
 def case(name: str, source: str, engines: tuple[str, ...], tags=("fast",), description: str = ""):
     """Register the decorated ``run(ctx) -> list[Metric]`` as a validation case."""
 

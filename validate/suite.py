@@ -11,11 +11,13 @@ import json
 import sys
 import time
 import traceback
-from concurrent.futures import ProcessPoolExecutor, as_completed
+from concurrent.futures import ProcessPoolExecutor, as_completed, wait
 from dataclasses import asdict, dataclass, field
 from typing import Callable, Sequence
 
-from .registry import COMPILES, REGISTRY, Case, CaseContext, Metric
+from bifilar import kernels
+
+from .registry import REGISTRY, Case, CaseContext, Metric
 
 # The compile time of every kernel the cases use, empty cache, 2 cores (benchmarks/first_run.py: what
 # the first run takes beyond a warm one, 64 s on a quiet machine).
@@ -108,15 +110,11 @@ def run_case(name: str, keep_trajectories: bool = False, keep_traces: bool = Fal
 def _announce_compile() -> bool:
     """One note, here in the main process, if the cases' kernels will compile (the workers keep quiet);
     whether they will."""
-    from bifilar import jit, smallmat
-    from bifilar.identification import slopes_kernel
-    from bifilar.identification.records import damping
-    from bifilar.motion import kane_kernel, nwire_kernel
-    from bifilar.rig import pose_kernel
-    from bifilar.seeds import tmt
-    from bifilar.sweep import kernel as sweep_kernel
+    import importlib
 
-    modules = (smallmat, kane_kernel, nwire_kernel, tmt, pose_kernel, slopes_kernel, sweep_kernel, damping)
+    from bifilar import jit, kernels
+
+    modules = [importlib.import_module(g.module) for g in kernels.GROUPS.values()]
     return jit.announce_modules("the Kane, N-wire, TMT and pose kernels", modules, seconds=COMPILE_SECONDS)
 
 
@@ -142,12 +140,12 @@ def run_cases(cases: list[Case], jobs: int = 2, json_path: str | None = None,
                   f"({time.perf_counter() - start:.0f} s elapsed)", file=sys.stderr, flush=True)
 
     if jobs > 1 and len(names) > 1:
-        # on an empty cache the cases that compile most kernels run first, one worker each (COMPILES)
-        first = [c.name for c in cases if cold and COMPILES in c.tags]
         with ProcessPoolExecutor(max_workers=jobs) as pool:
-            for batch in (first, [n for n in names if n not in first]):
-                for future in as_completed([pool.submit(run_case, n, keep, traces) for n in batch]):
-                    finished(future.result())
+            if cold:  # each worker compiles one share of the kernels, none twice (bifilar.kernels)
+                for done_share in wait([pool.submit(kernels.precompile, share) for share in kernels.shares(jobs)]).done:
+                    done_share.result()
+            for future in as_completed([pool.submit(run_case, n, keep, traces) for n in names]):
+                finished(future.result())
     else:
         for n in names:
             finished(run_case(n, keep, traces))

@@ -21,7 +21,7 @@ from ..assets import rig
 from ..engines import engines
 from ..engines.mjcf import compile_model
 from ..metrics import max_abs, period, yaw
-from ..registry import COMPILES, CaseContext, case, check
+from ..registry import CaseContext, case, check
 
 RTOL = 1e-10
 YAW = np.array([0.0, 0.0, 1.0])
@@ -61,8 +61,7 @@ def added_mass_limits(ctx: CaseContext):
     return out
 
 
-@case("air-torsion-period-shift", source="Lamb 1932 §121; 000 ch. 5.2", engines=("kane",),
-      tags=("fast", COMPILES))
+@case("air-torsion-period-shift", source="Lamb 1932 §121; 000 ch. 5.2", engines=("kane",))
 def torsion_shift(ctx: CaseContext):
     """Yaw period in air over the vacuum one: (T_air / T_vac)^2 = (I + I_A) / I, closed form."""
     r = wing(drag=False)

@@ -64,7 +64,7 @@ from ..studies.boat_study import (DT_OUT, PERIODS, SUSPENSION, Motion, load_run,
 from ..engines import mujoco_rig
 from ..engines.kane import to_trajectory
 from ..metrics import max_abs, period
-from ..registry import COMPILES, CaseContext, case, check
+from ..registry import CaseContext, case, check
 
 IDENTIFY_RTOL = 1e-8
 REST_RTOL = 1e-8
@@ -79,8 +79,7 @@ PERIOD_RTOL = 1e-8  # the sweep's linear period vs the Kane-timed, amplitude-cor
 SIGMA_RTOL = 1e-5  # forward differences of the propagation
 
 
-@case("boat-study", source="000 ch. 8.2-8.4", engines=("kane", "mujoco"),
-      tags=("fast", COMPILES))
+@case("boat-study", source="000 ch. 8.2-8.4", engines=("kane", "mujoco"))
 def boat_study(ctx: CaseContext):
     """Solar Boat, configurations 1-3 of models/solar_boat/suspension.toml: every moment identified
     from its timed motion recovers the truth, the rest tensions match the closed form, the boat clears

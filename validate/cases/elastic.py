@@ -33,7 +33,7 @@ from ..assets import rig
 from ..engines import engines, mujoco_rig
 from ..engines.mjcf import CHOSEN
 from ..metrics import max_abs, period, yaw
-from ..registry import COMPILES, CaseContext, case, check
+from ..registry import CaseContext, case, check
 
 RTOL = 1e-10
 LINEAR_TOL = 1e-9  # closed-form linear periods: eigenproblems of 6 x 6 matrices, rounding only
@@ -122,8 +122,7 @@ def with_ea(r: Rig, ea: float) -> Rig:
     return replace(r, wires=tuple(replace(w, axial_stiffness=ea) for w in r.wires))
 
 
-@case("elastic-quadrifilar-closed-form", source="issue 20 (symmetric four-wire platform)", engines=("kane", "analytic"),
-      tags=("fast", COMPILES))
+@case("elastic-quadrifilar-closed-form", source="issue 20 (symmetric four-wire platform)", engines=("kane", "analytic"))
 def quadrifilar_closed_form(ctx: CaseContext):
     """Symmetric quadrifilar on vertical elastic wires: load shares, the six linear periods against the
     closed forms, and the elastic N-wire yaw period at 1e-3 rad against the linear one."""

@@ -18,7 +18,7 @@ from validate.engines import seed002_mujoco
 from validate.engines import tmt_mujoco as tm
 
 from ..metrics import channel_difference, energy_drift, max_abs
-from ..registry import COMPILES, CaseContext, case, check
+from ..registry import CaseContext, case, check
 from ..trajectory import Trajectory
 
 DT_OUT = 0.01  # s, sampling of every trajectory
@@ -37,7 +37,7 @@ def _random_states(rng: np.random.Generator, n: int) -> list[tuple[np.ndarray, n
     return [(rng.uniform(-np.pi, np.pi, 2), rng.uniform(-40.0, 40.0, 2)) for _ in range(n)]
 
 
-@case("seed002-mass-bias", source=SOURCE, engines=("tmt", "mujoco"), tags=("fast", COMPILES))
+@case("seed002-mass-bias", source=SOURCE, engines=("tmt", "mujoco"))
 def mass_bias(ctx: CaseContext):
     """M* = B^T M B against mj_fullM, and N* q' - F* against qfrc_bias, at random states."""
     p = seed002.load()

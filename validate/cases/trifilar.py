@@ -28,7 +28,7 @@ from bifilar.motion.modes import linearize
 from ..assets import rig
 from ..engines import engines
 from ..metrics import max_abs, period, quat_angle_difference, yaw
-from ..registry import COMPILES, CaseContext, case, check
+from ..registry import CaseContext, case, check
 from .rig_engines import AGREEMENT, MUJOCO, agreement_metrics
 
 RTOL = 1e-10
@@ -180,8 +180,7 @@ def added_mass(ctx: CaseContext):
     return out
 
 
-@case("nwire-vs-kane-tseng", source="issue 11 (two wires: two derivations)", engines=("nwire", "kane"),
-      tags=("fast", COMPILES))
+@case("nwire-vs-kane-tseng", source="issue 11 (two wires: two derivations)", engines=("nwire", "kane"))
 def nwire_vs_kane_tseng(ctx: CaseContext):
     """On two-wire rigs the N-wire model (Newton-Euler, tensions as multipliers) and the Kane-Tseng
     model (five thesis angles) are independent derivations: over 10 s they agree to integrator error."""
