@@ -7,7 +7,9 @@ with a new temporary NUMBA_CACHE_DIR, at :data:`bifilar.jit.OPT_LEVEL`; the figu
 time spent in ``compile`` (numba compiles on one thread), so it is steadier than wall time on a busy
 machine. The code measured is this checkout's (the subprocess's PYTHONPATH is the script's repository, not
 an installed copy). A group's figure includes the callees it compiles (the sweep compiles pose and N-wire
-kernels), so the groups overlap; ``all`` compiles every group in one process, as a first run does.
+kernels), so the groups overlap; ``all`` compiles every group in one process, as a first run does, and
+compiles a callee or a numpy implementation (``@`` for one pair of layouts, a LAPACK call) once for all
+groups: a saving in one group shows in ``all`` only where no other group still compiles the same thing.
 
     python benchmarks/compile_cpu.py              # every group, then all
     python benchmarks/compile_cpu.py kane pose    # the named groups only
