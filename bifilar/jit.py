@@ -56,7 +56,9 @@ def kernels_key(root: Path = Path(__file__).parent) -> str:
 # interleaved rounds) and the sweep as fast (1.82-1.85e3 configurations/s/core against 1.83-1.86e3). A
 # first run compiles every kernel; the warm ones spend most of their time in MuJoCo and scipy. What each
 # group of kernels costs to compile: benchmarks/compile_cpu.py (CPU s in a fresh cache; the Kane group
-# 21.7 s, 25.8 before its cross products were written out and its accelerations kernel dropped).
+# 21.7 s, 25.8 before its cross products were written out and its accelerations kernel dropped; pose
+# 10.5-12.5, slopes 11.2-15.5, sweep 27.2-27.4, elastic 13.4-13.5, all 54.2-56.3, against 15.7-18.1,
+# 16.3-18.3, 29.6-33.5, 14.0-14.2 and 59.5-60.2 before their small products were written as loops).
 OPT_LEVEL = "1"
 
 

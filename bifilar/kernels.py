@@ -27,9 +27,9 @@ from bifilar.jit import cached
 @dataclass(frozen=True)
 class Group:
     """A module's kernels (``name: signature``, compiled in this order) and ``cost``, the CPU seconds
-    compiling them takes once the groups before it in :data:`GROUPS` are cached (``python
-    benchmarks/compile_cpu.py``: the groups in order in one process; the shares are balanced by it, so
-    only its proportions matter)."""
+    compiling them took in its share (``python benchmarks/compile_cpu.py shares 2``; a process's first
+    group also pays for numba's own functions it compiles once per process). The shares are balanced
+    by it, so only its proportions matter."""
 
     module: str
     kernels: dict[str, str]
@@ -39,25 +39,25 @@ class Group:
 GROUPS = {
     "kane": Group("bifilar.motion.kane_kernel", {
         "air_terms": "a2 a1 a1 a1", "rhs": "a1 a1 i", "observe": "a2 a1 i", "loads": "a1 a1 a1 i",
-        "eom": "a1 a1 a1 i", "pose": "a1 a1 i"}, 23.0),
+        "eom": "a1 a1 a1 i", "pose": "a1 a1 i"}, 19.2),
     "pose": Group("bifilar.rig.pose_kernel", {
         "newton_equilibrium": "a1 a2 a1 a2 a2 a1 f f i", "reduced_matrices": "a1 a2 a1 a2 a2 a2 f f f",
         "equilibrium_balance": "a1 a2 a1 a2 a2 a1 f f", "equilibrium_residual": "a1 a2 a1 a2 a2 a1 f f",
         "constraint_jacobian": "a2 a2", "constraint_hessian": "a2 a2 a1 i", "cross_matrix": "a1",
-        "rotation_vector_matrix": "a1", "wire_geometry": "a1 a2 a2 a2"}, 7.8),
+        "rotation_vector_matrix": "a1", "wire_geometry": "a1 a2 a2 a2"}, 10.1),
     "nwire": Group("bifilar.motion.nwire_kernel", {
         "rhs": "a1 a2 a2 a2 f f a1", "observe": "a2 a2 a2 a2 f f a1", "dynamics": "a1 a2 a2 a2 f f a1",
         "dynamics_jacobian": "a1 a2 a2", "quat_matrix": "a1", "matrix_quat": "a2", "state_rate": "a1 a1",
-        "compatible_tensions": "a1 a2 a2 a2 f f a1 a1 a1"}, 14.9),
+        "compatible_tensions": "a1 a2 a2 a2 f f a1 a1 a1"}, 13.3),
     "elastic": Group("bifilar.motion.elastic_kernel", {
-        "rhs": "a1 a2 a2 a1 a1 a2 f f a1", "observe": "a2 a2 a2 a1 a1 a2 f f a1"}, 5.2),
+        "rhs": "a1 a2 a2 a1 a1 a2 f f a1", "observe": "a2 a2 a2 a1 a1 a2 f f a1"}, 5.6),
     "slopes": Group("bifilar.identification.slopes_kernel", {
-        "period_slopes": "a1 a1 i f f a1 a2 a1 a3 a2 a2 a3"}, 5.2),
+        "period_slopes": "a1 a1 i f f a1 a2 a1 a3 a2 a2 a3"}, 5.3),
     "sweep": Group("bifilar.sweep.kernel", {
         "continued_modes": "a2 a2 a1 f f a2 f a1 a2 a1 f f f f",
-        "peak_tension": "a1 a2 a2 a1 a1 a1 a2 a2 a2 f f a1"}, 5.4),
-    "tmt": Group("bifilar.seeds.tmt", {"_kinematics": "a1 a1 a2 a2 i1 a1 i1 i"}, 4.5),
-    "damping": Group("bifilar.identification.records.damping", {"_cycle_from": "f f f f f"}, 1.0),
+        "peak_tension": "a1 a2 a2 a1 a1 a1 a2 a2 a2 f f a1"}, 4.8),
+    "tmt": Group("bifilar.seeds.tmt", {"_kinematics": "a1 a1 a2 a2 i1 a1 i1 i"}, 4.4),
+    "damping": Group("bifilar.identification.records.damping", {"_cycle_from": "f f f f f"}, 0.6),
     "modes": Group("bifilar.motion.modes", {"resolution": "f f f"}, 0.1),
 }
 

@@ -27,6 +27,7 @@ import numba as nb
 import numpy as np
 
 from bifilar.rig import pose_kernel
+from bifilar.smallmat import mm, mv
 
 _SINGULAR = 1e-10  # smallest / largest singular value of the equilibrium Jacobian treated as singular
 _CHORD_STEPS = 2
@@ -80,23 +81,36 @@ def mass_matrix(rot, inertia, mass, air_body, air):
         rot6 = np.zeros((6, 6))
         rot6[:3, :3] = rot
         rot6[3:, 3:] = rot
-        m6 += rot6 @ air_body @ rot6.T
+        m6 += mm(mm(rot6, air_body), rot6.T.copy())
     return m6
 
 
 @nb.njit(cache=True)
 def projector(jac):
-    """I - J^T (J J^T)^-1 J: the projection (6 x 6) onto the null space of the constraint gradients."""
-    out = -(jac.T @ np.linalg.solve(jac @ jac.T, jac))
-    for k in range(6):
-        out[k, k] += 1.0
+    """I - J^T (J J^T)^-1 J: the projection (6 x 6) onto the null space of the constraint gradients.
+    The products are loops: numba's ``@`` compiles a BLAS path per operand layout, and J^T is another
+    layout than J (:mod:`bifilar.smallmat`)."""
+    n = jac.shape[0]
+    gram = np.zeros((n, n))
+    for a in range(n):
+        for b in range(n):
+            for k in range(6):
+                gram[a, b] += jac[a, k] * jac[b, k]
+    sol = np.linalg.solve(gram, jac)
+    out = np.zeros((6, 6))
+    for r in range(6):
+        for c in range(6):
+            acc = 0.0
+            for a in range(n):
+                acc += jac[a, r] * sol[a, c]
+            out[r, c] = (1.0 if r == c else 0.0) - acc
     return out
 
 
 @nb.njit(cache=True)
 def rayleigh(proj, k6, m6, q):
     """p^T K p / p^T M p with p = ``proj`` q, the shape q moved onto the tangent space."""
-    p = proj @ q
+    p = mv(proj, q)
     num = 0.0
     den = 0.0
     for r in range(6):
@@ -140,9 +154,9 @@ def period_slopes(x, h, n_wires, gravity, scale, com0, rot0, t0, inertias, shape
         com, rot, tn = com0.copy(), rot0.copy(), t0 / weight
         for _ in range(_CHORD_STEPS):
             res = pose_kernel.equilibrium_balance(com, rot, tn * weight, arms, anchors, lengths, weight, scale)
-            step = -(inverse @ res)
+            step = -mv(inverse, res)
             com += step[:3]
-            rot = pose_kernel.rotation_vector_matrix(step[3:6]) @ rot
+            rot = mm(pose_kernel.rotation_vector_matrix(step[3:6]), rot)
             tn += step[6:]
         res = pose_kernel.equilibrium_balance(com, rot, tn * weight, arms, anchors, lengths, weight, scale)
         if not np.abs(res).max() < _CHORD_RESIDUAL:

@@ -23,6 +23,17 @@ from bifilar.motion.kane_kernel import P_AIR as AIR_FLAG
 from bifilar.motion.kane_kernel import air_terms
 from bifilar.motion.nwire_kernel import STATE_SIZE, quat_matrix, state_rate
 from bifilar.smallmat import cross as _cross
+from bifilar.smallmat import mm as _mm
+from bifilar.smallmat import mv as _mv
+
+
+@njit(cache=True)
+def _dot(a, b):
+    """a . b with a loop: numba sends a 1-D ``@`` to BLAS, a call (and a compile) dearer than the sum."""
+    acc = 0.0
+    for k in range(a.shape[0]):
+        acc += a[k] * b[k]
+    return acc
 
 
 @njit(cache=True)
@@ -31,16 +42,16 @@ def dynamics(y, arms, anchors, lengths, springs, inertia_body, mass, gravity, ai
     n = arms.shape[0]
     c, v, om = y[0:3], y[7:10], y[10:13]
     rot = quat_matrix(y[3:7])
-    iw = rot @ inertia_body @ rot.T
+    iw = _mm(_mm(rot, inertia_body), rot.T.copy())
     f = np.zeros(6)
     f[2] = -mass * gravity
-    f[3:] = -_cross(om, iw @ om)
+    f[3:] = -_cross(om, _mv(iw, om))
     tension = np.empty(n)
     stretch = np.empty(n)
     for i in range(n):
-        s = rot @ arms[i]
+        s = _mv(rot, arms[i])
         d = anchors[i] - c - s
-        rho = np.sqrt(d @ d)
+        rho = np.sqrt(_dot(d, d))
         stretch[i] = rho - lengths[i]
         tension[i] = springs[i] * stretch[i] if stretch[i] > 0.0 else 0.0
         pull = tension[i] * d / rho
@@ -81,12 +92,12 @@ def observe(Y, arms, anchors, lengths, springs, inertia_body, mass, gravity, air
         frames[k] = rot
         _, ten[k], stretch[k] = dynamics(y, arms, anchors, lengths, springs, inertia_body, mass, gravity, air)
         om, v = y[10:13], y[7:10]
-        iw = rot @ inertia_body @ rot.T
-        energy[k] = 0.5 * mass * (v @ v) + 0.5 * (om @ (iw @ om)) + mass * gravity * y[2]
+        iw = _mm(_mm(rot, inertia_body), rot.T.copy())
+        energy[k] = 0.5 * mass * _dot(v, v) + 0.5 * _dot(om, _mv(iw, om)) + mass * gravity * y[2]
         for i in range(n):
             if stretch[k, i] > 0.0:
                 energy[k] += 0.5 * springs[i] * stretch[k, i] ** 2
         if air[AIR_FLAG] != 0.0:
             x = np.concatenate((v, om))
-            energy[k] += 0.5 * (x @ (air_terms(rot, v, om, air)[0] @ x))
+            energy[k] += 0.5 * _dot(x, _mv(air_terms(rot, v, om, air)[0], x))
     return frames, ten, stretch, energy

@@ -89,9 +89,7 @@ def constraint_jacobian(s, u):
 def constraint_hessian(s, u, rho, i):
     """hess g_i in q = (x, theta) at q = 0 (6 x 6, symmetric), written out in blocks:
     with A = (I - u u^T) / rho and S = [s]x, P^T A P = [[A, -A S], [S A, -S A S]]."""
-    a = -np.outer(u[i], u[i]) / rho[i]
-    for k in range(3):
-        a[k, k] += 1.0 / rho[i]
+    a = _projector(u, rho, i)
     sx = cross_matrix(s[i])
     a_s = np.zeros((3, 3))
     s_a_s = np.zeros((3, 3))
@@ -141,6 +139,29 @@ def _balance(s, u, rho, tensions, lengths, weight, scale):
 
 
 @nb.njit(cache=True)
+def _projector(u, rho, i):
+    """(I - u_i u_i^T) / rho_i, written out (``np.eye`` and ``np.outer`` cost more to compile than the
+    nine products; the same arithmetic)."""
+    a = np.empty((3, 3))
+    for r in range(3):
+        for c in range(3):
+            a[r, c] = ((1.0 if r == c else 0.0) - u[i, r] * u[i, c]) / rho[i]
+    return a
+
+
+@nb.njit(cache=True)
+def _mm3(a, b):
+    """a @ b of two 3 x 3 matrices with loops: numba's ``@`` instantiates its BLAS path per operand
+    layout, which costs more to compile than these 27 products."""
+    out = np.zeros((3, 3))
+    for r in range(3):
+        for c in range(3):
+            for k in range(3):
+                out[r, c] += a[r, k] * b[k, c]
+    return out
+
+
+@nb.njit(cache=True)
 def equilibrium_residual(com, rot, tensions, arms, anchors, lengths, weight, scale):
     """Force balance / W, moment balance about the COM / (W scale) and length errors / scale
     (6 + N), and its Jacobian with respect to (x, theta, t / W)."""
@@ -151,20 +172,27 @@ def equilibrium_residual(com, rot, tensions, arms, anchors, lengths, weight, sca
     for i in range(n):
         t = tensions[i] / weight
         # du = -(I - u u^T) / rho dp,  dp = dx - [s]x dtheta,  ds = dtheta x s = -[s]x dtheta
-        proj = (np.eye(3) - np.outer(u[i], u[i])) / rho[i]
+        proj = _projector(u, rho, i)
         sx = cross_matrix(s[i])
-        du_dx = -proj
-        du_dth = proj @ sx
-        ux = cross_matrix(u[i])
-        jac[:3, :3] += t * du_dx
-        jac[:3, 3:6] += t * du_dth
-        jac[:3, 6 + i] = u[i]
+        du_dth = _mm3(proj, sx)
         # d(s x u) = ds x u + s x du = [u]x [s]x dtheta + [s]x du
-        jac[3:6, :3] += t * (sx @ du_dx) / scale
-        jac[3:6, 3:6] += t * (ux @ sx + sx @ du_dth) / scale
-        jac[3:6, 6 + i] = np.cross(s[i], u[i]) / scale
-        jac[6 + i, :3] = -u[i] / scale
-        jac[6 + i, 3:6] = np.cross(u[i], s[i]) / scale
+        s_du_dx = _mm3(sx, -proj)
+        turn = _mm3(cross_matrix(u[i]), sx) + _mm3(sx, du_dth)
+        for r in range(3):
+            for c in range(3):
+                jac[r, c] += t * -proj[r, c]
+                jac[r, 3 + c] += t * du_dth[r, c]
+                jac[3 + r, c] += t * s_du_dx[r, c] / scale
+                jac[3 + r, 3 + c] += t * turn[r, c] / scale
+            jac[r, 6 + i] = u[i, r]
+            jac[6 + i, r] = -u[i, r] / scale
+        # s x u and u x s, written out as np.cross computes them
+        jac[3, 6 + i] = (s[i, 1] * u[i, 2] - s[i, 2] * u[i, 1]) / scale
+        jac[4, 6 + i] = (s[i, 2] * u[i, 0] - s[i, 0] * u[i, 2]) / scale
+        jac[5, 6 + i] = (s[i, 0] * u[i, 1] - s[i, 1] * u[i, 0]) / scale
+        jac[6 + i, 3] = (u[i, 1] * s[i, 2] - u[i, 2] * s[i, 1]) / scale
+        jac[6 + i, 4] = (u[i, 2] * s[i, 0] - u[i, 0] * s[i, 2]) / scale
+        jac[6 + i, 5] = (u[i, 0] * s[i, 1] - u[i, 1] * s[i, 0]) / scale
     return res, jac
 
 
@@ -188,14 +216,19 @@ def newton_equilibrium(com, rot, tensions, arms, anchors, lengths, weight, scale
         # Least squares: the minimum-norm step where the Jacobian is singular (a neutral tilt
         # about the line of two attachments), Newton's step elsewhere.
         step = np.linalg.lstsq(jac, -res, 1e-13)[0]
-        if not np.all(np.isfinite(step)):
+        finite = True
+        for v in step:
+            finite = finite and np.isfinite(v)
+        if not finite:
             break
         # Limit the turn and the shift per step: Newton far from the solution may jump to the
         # inverted equilibrium; a damped step keeps it in the basin it started in.
-        shrink = max(1.0, np.sqrt(step[3:6] @ step[3:6]) / 0.2, np.sqrt(step[:3] @ step[:3]) / (0.2 * scale))
+        shift = step[0] * step[0] + step[1] * step[1] + step[2] * step[2]
+        turn = step[3] * step[3] + step[4] * step[4] + step[5] * step[5]
+        shrink = max(1.0, np.sqrt(turn) / 0.2, np.sqrt(shift) / (0.2 * scale))
         step /= shrink
         com += step[:3]
-        rot = rotation_vector_matrix(step[3:6]) @ rot
+        rot = _mm3(rotation_vector_matrix(step[3:6]), rot)
         t += step[6 : 6 + n]
     res, jac = equilibrium_residual(com, rot, t * weight, arms, anchors, lengths, weight, scale)
     return com, rot, t * weight, np.abs(res).max(), max_iter + 1
@@ -224,10 +257,31 @@ def reduced_matrices(com, rot, tensions, arms, anchors, inertia_body, mass, scal
     m6 = np.zeros((6, 6))
     for k in range(3):
         m6[k, k] = mass
-    m6[3:, 3:] = rot @ inertia_body @ rot.T
+    ri = _mm3(rot, inertia_body)
+    for r in range(3):
+        for c in range(3):
+            for k in range(3):
+                m6[3 + r, 3 + c] += ri[r, k] * rot[c, k]
     k6 = np.zeros((6, 6))
     for i in range(n):
         k6 += tensions[i] * constraint_hessian(s, u, rho, i)
-    mr = z.T @ m6 @ z
-    kr = z.T @ k6 @ z
+    mr = _reduce(z, m6)
+    kr = _reduce(z, k6)
     return z, 0.5 * (mr + mr.T), 0.5 * (kr + kr.T), rank
+
+
+@nb.njit(cache=True)
+def _reduce(z, m):
+    """(Z^T M) Z with loops (see :func:`_mm3`)."""
+    n = z.shape[1]
+    zm = np.zeros((n, 6))
+    for a in range(n):
+        for r in range(6):
+            for c in range(6):
+                zm[a, c] += z[r, a] * m[r, c]
+    out = np.zeros((n, n))
+    for a in range(n):
+        for b in range(n):
+            for c in range(6):
+                out[a, b] += zm[a, c] * z[c, b]
+    return out

@@ -24,6 +24,7 @@ from bifilar.motion import nwire_kernel as NK
 from bifilar.motion.modes import resolution  # the neutral and degenerate tests of linearize
 from bifilar.rig import pose_kernel
 from bifilar.rig.statics import NEWTON_ITERATIONS, RESIDUAL  # the same Newton as rest_pose
+from bifilar.smallmat import mm, mv  # loops: numba's `@` compiles a BLAS path per operand layout
 
 OK, NO_NEWTON, SLACK, NO_MODES, UNSTABLE, NEUTRAL, DEGENERATE = range(7)
 
@@ -49,7 +50,7 @@ def continued_modes(arms, anchors, lengths, mass, gravity, inertia, scale, com, 
     if n == 0:
         return NO_MODES, com, rot, tensions, empty, np.zeros((6, 0))
     chol_inv = np.linalg.inv(np.linalg.cholesky(mr))
-    a = chol_inv @ kr @ chol_inv.T
+    a = mm(mm(chol_inv, kr), chol_inv.T.copy())
     w2, y = np.linalg.eigh(0.5 * (a + a.T))
     big = max(np.abs(w2).max(), 1e-300)
     if w2[0] < -slack_rtol * big:
@@ -60,7 +61,7 @@ def continued_modes(arms, anchors, lengths, mass, gravity, inertia, scale, com, 
     for k in range(n - 1):
         if w2[k + 1] - w2[k] <= gap:
             return DEGENERATE, com, rot, tensions, w2, np.zeros((6, 0))
-    return OK, com, rot, tensions, w2, z @ (chol_inv.T @ y)
+    return OK, com, rot, tensions, w2, mm(z, mm(chol_inv.T, y))
 
 
 @nb.njit(cache=True)
@@ -82,13 +83,13 @@ def peak_tension(com, rot, shapes, omegas, springs, base, arms, anchors, inertia
         y[7:13] = omegas[k] * shapes[k]
         if springs.size:
             peak = max(peak, NK.compatible_tensions(y, arms, anchors, inertia, mass, gravity, air, springs, base).max())
-            stretch = springs * np.abs(NK.dynamics_jacobian(y, arms, anchors) @ shapes[k])
+            stretch = springs * np.abs(mv(NK.dynamics_jacobian(y, arms, anchors), shapes[k]))
             peak = max(peak, (base + stretch).max())
             continue
         peak = max(peak, NK.dynamics(y, arms, anchors, inertia, mass, gravity, air)[1].max())
         for sign in (1.0, -1.0):
             y[:3] = com + sign * shapes[k, :3]
-            y[3:7] = NK.matrix_quat(pose_kernel.rotation_vector_matrix(sign * shapes[k, 3:]) @ rot)
+            y[3:7] = NK.matrix_quat(mm(pose_kernel.rotation_vector_matrix(sign * shapes[k, 3:]), rot))
             y[7:13] = 0.0
             peak = max(peak, NK.dynamics(y, arms, anchors, inertia, mass, gravity, air)[1].max())
     return peak
