@@ -285,10 +285,12 @@ def test_a_closed_pipe_is_quiet():
 @pytest.mark.slow
 def test_ctrl_c_is_one_line_and_exit_130(tmp_path):
     proc = subprocess.Popen([sys.executable, "-m", "validate", "simulate", str(RIGS / "plate.toml"), "--duration",
-                             "900", "--out", str(tmp_path / "x.csv")], cwd=ROOT, stdout=subprocess.PIPE,
+                             "3600", "--out", str(tmp_path / "x.csv")], cwd=ROOT, stdout=subprocess.PIPE,
                             stderr=subprocess.PIPE, text=True,
                             preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
-    time.sleep(6.0)  # into the integration (imports take ~1.5 s; an interrupt during them is handled too)
+    # into the integration (imports take ~1.5 s; an interrupt during them is handled too), which runs
+    # ~20 s warm for 3600 s of motion (900 s took 6.2 s in all, and the signal met the exit)
+    time.sleep(6.0)
     proc.send_signal(signal.SIGINT)
     _, err = proc.communicate(timeout=60)
     lines = [line for line in err.splitlines() if not line.startswith("note: compiling")]
