@@ -19,9 +19,10 @@ from bifilar import kernels
 
 from .registry import REGISTRY, Case, CaseContext, Metric
 
-# The compile time of every kernel the cases use, empty cache, 2 cores (benchmarks/first_run.py: what
-# the first run takes beyond a warm one, 64 s on a quiet machine).
-COMPILE_SECONDS = "45-100"
+# The compile time of every kernel the cases use, empty cache, 2 cores: each worker compiles its share
+# in ~31 s of CPU (python benchmarks/compile_cpu.py shares 2), and the first run took 65.2 s against
+# 32.7 s warm on a quiet machine (python benchmarks/first_run.py all); a busy machine takes longer.
+COMPILE_SECONDS = "30-60"
 
 
 @dataclass
