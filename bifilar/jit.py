@@ -153,14 +153,18 @@ def _dispatchers(module: types.ModuleType) -> dict:
 
 
 def interpreted(module: types.ModuleType) -> types.ModuleType:
-    """``module``'s plain-Python twin: its source run again in a new namespace, every kernel defined
-    there replaced by its Python function, so that kernels calling each other call the Python ones.
+    """``module``'s plain-Python twin: its source run again in a new namespace, every kernel there
+    replaced by its Python function, so that kernels calling each other call the Python ones: those it
+    defines and those it imports (:mod:`bifilar.smallmat`'s products, which call no other kernel).
     Nothing is compiled (defining a numba dispatcher is cheap; its first call compiles)."""
+    from numba.core.registry import CPUDispatcher
+
     twin = types.ModuleType(f"{module.__name__}[interpreted]", module.__doc__)
     twin.__file__ = module.__file__
     exec(compile(inspect.getsource(module), module.__file__, "exec"), vars(twin))
-    for name, kernel in _dispatchers(twin).items():
-        setattr(twin, name, kernel.py_func)
+    for name, value in list(vars(twin).items()):
+        if isinstance(value, CPUDispatcher):
+            setattr(twin, name, value.py_func)
     return twin
 
 

@@ -88,22 +88,12 @@ def mass_matrix(rot, inertia, mass, air_body, air):
 @nb.njit(cache=True)
 def projector(jac):
     """I - J^T (J J^T)^-1 J: the projection (6 x 6) onto the null space of the constraint gradients.
-    The products are loops: numba's ``@`` compiles a BLAS path per operand layout, and J^T is another
-    layout than J (:mod:`bifilar.smallmat`)."""
-    n = jac.shape[0]
-    gram = np.zeros((n, n))
-    for a in range(n):
-        for b in range(n):
-            for k in range(6):
-                gram[a, b] += jac[a, k] * jac[b, k]
-    sol = np.linalg.solve(gram, jac)
-    out = np.zeros((6, 6))
-    for r in range(6):
-        for c in range(6):
-            acc = 0.0
-            for a in range(n):
-                acc += jac[a, r] * sol[a, c]
-            out[r, c] = (1.0 if r == c else 0.0) - acc
+    The products are :mod:`bifilar.smallmat`'s loops: numba's ``@`` compiles a BLAS path per operand
+    layout, and J^T is another layout than J."""
+    jac_t = jac.T.copy()
+    out = -mm(jac_t, np.linalg.solve(mm(jac, jac_t), jac))
+    for k in range(6):
+        out[k, k] += 1.0
     return out
 
 

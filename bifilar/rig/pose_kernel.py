@@ -26,6 +26,8 @@ from __future__ import annotations
 import numba as nb
 import numpy as np
 
+from bifilar.smallmat import cross, mm
+
 
 @nb.njit(cache=True)
 def cross_matrix(v):
@@ -150,18 +152,6 @@ def _projector(u, rho, i):
 
 
 @nb.njit(cache=True)
-def _mm3(a, b):
-    """a @ b of two 3 x 3 matrices with loops: numba's ``@`` instantiates its BLAS path per operand
-    layout, which costs more to compile than these 27 products."""
-    out = np.zeros((3, 3))
-    for r in range(3):
-        for c in range(3):
-            for k in range(3):
-                out[r, c] += a[r, k] * b[k, c]
-    return out
-
-
-@nb.njit(cache=True)
 def equilibrium_residual(com, rot, tensions, arms, anchors, lengths, weight, scale):
     """Force balance / W, moment balance about the COM / (W scale) and length errors / scale
     (6 + N), and its Jacobian with respect to (x, theta, t / W)."""
@@ -174,10 +164,10 @@ def equilibrium_residual(com, rot, tensions, arms, anchors, lengths, weight, sca
         # du = -(I - u u^T) / rho dp,  dp = dx - [s]x dtheta,  ds = dtheta x s = -[s]x dtheta
         proj = _projector(u, rho, i)
         sx = cross_matrix(s[i])
-        du_dth = _mm3(proj, sx)
+        du_dth = mm(proj, sx)
         # d(s x u) = ds x u + s x du = [u]x [s]x dtheta + [s]x du
-        s_du_dx = _mm3(sx, -proj)
-        turn = _mm3(cross_matrix(u[i]), sx) + _mm3(sx, du_dth)
+        s_du_dx = mm(sx, -proj)
+        turn = mm(cross_matrix(u[i]), sx) + mm(sx, du_dth)
         for r in range(3):
             for c in range(3):
                 jac[r, c] += t * -proj[r, c]
@@ -186,13 +176,8 @@ def equilibrium_residual(com, rot, tensions, arms, anchors, lengths, weight, sca
                 jac[3 + r, 3 + c] += t * turn[r, c] / scale
             jac[r, 6 + i] = u[i, r]
             jac[6 + i, r] = -u[i, r] / scale
-        # s x u and u x s, written out as np.cross computes them
-        jac[3, 6 + i] = (s[i, 1] * u[i, 2] - s[i, 2] * u[i, 1]) / scale
-        jac[4, 6 + i] = (s[i, 2] * u[i, 0] - s[i, 0] * u[i, 2]) / scale
-        jac[5, 6 + i] = (s[i, 0] * u[i, 1] - s[i, 1] * u[i, 0]) / scale
-        jac[6 + i, 3] = (u[i, 1] * s[i, 2] - u[i, 2] * s[i, 1]) / scale
-        jac[6 + i, 4] = (u[i, 2] * s[i, 0] - u[i, 0] * s[i, 2]) / scale
-        jac[6 + i, 5] = (u[i, 0] * s[i, 1] - u[i, 1] * s[i, 0]) / scale
+        jac[3:6, 6 + i] = cross(s[i], u[i]) / scale
+        jac[6 + i, 3:6] = cross(u[i], s[i]) / scale
     return res, jac
 
 
@@ -228,7 +213,7 @@ def newton_equilibrium(com, rot, tensions, arms, anchors, lengths, weight, scale
         shrink = max(1.0, np.sqrt(turn) / 0.2, np.sqrt(shift) / (0.2 * scale))
         step /= shrink
         com += step[:3]
-        rot = _mm3(rotation_vector_matrix(step[3:6]), rot)
+        rot = mm(rotation_vector_matrix(step[3:6]), rot)
         t += step[6 : 6 + n]
     res, jac = equilibrium_residual(com, rot, t * weight, arms, anchors, lengths, weight, scale)
     return com, rot, t * weight, np.abs(res).max(), max_iter + 1
@@ -257,31 +242,11 @@ def reduced_matrices(com, rot, tensions, arms, anchors, inertia_body, mass, scal
     m6 = np.zeros((6, 6))
     for k in range(3):
         m6[k, k] = mass
-    ri = _mm3(rot, inertia_body)
-    for r in range(3):
-        for c in range(3):
-            for k in range(3):
-                m6[3 + r, 3 + c] += ri[r, k] * rot[c, k]
+    m6[3:, 3:] = mm(mm(rot, inertia_body), rot.T.copy())
     k6 = np.zeros((6, 6))
     for i in range(n):
         k6 += tensions[i] * constraint_hessian(s, u, rho, i)
-    mr = _reduce(z, m6)
-    kr = _reduce(z, k6)
+    zt = z.T.copy()
+    mr = mm(mm(zt, m6), z)
+    kr = mm(mm(zt, k6), z)
     return z, 0.5 * (mr + mr.T), 0.5 * (kr + kr.T), rank
-
-
-@nb.njit(cache=True)
-def _reduce(z, m):
-    """(Z^T M) Z with loops (see :func:`_mm3`)."""
-    n = z.shape[1]
-    zm = np.zeros((n, 6))
-    for a in range(n):
-        for r in range(6):
-            for c in range(6):
-                zm[a, c] += z[r, a] * m[r, c]
-    out = np.zeros((n, n))
-    for a in range(n):
-        for b in range(n):
-            for c in range(6):
-                out[a, b] += zm[a, c] * z[c, b]
-    return out
