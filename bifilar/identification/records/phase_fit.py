@@ -26,7 +26,7 @@ class PhaseFit:
     """The phases' law fitted to a pass's good cycles (:mod:`.phase_law`). Times in s, omega in rad/s.
 
     ``names``: the parameters (phi, omega, then the law's: the excess terms, the scale ``q`` or ``kappa``
-    of a proportional record), ``params`` their values, ``omega0`` = params[1]. ``cov_stat``, ``cov_law``:
+    of a proportional record), ``params`` their values (``phi0`` and ``omega0`` the first two). ``cov_stat``, ``cov_law``:
     their covariance, the record's noise (block sandwich plus the envelope's doubt) and the priors' part;
     ``prior_gain``: omega0's response to each excess prior off by one sigma. ``residual``, ``var``: each
     good cycle's phase residual (rad) and variance. ``ideal``: the ideal law's coefficient s (1/rad^2;
@@ -38,7 +38,7 @@ class PhaseFit:
     was made for, which the next fit reuses while omega stays within 1e-6 (:meth:`.phase_law.Model.fit`).
     On the phase grid ``grid``: the envelope ``amplitude`` (signal units), the swing ``peak`` (rad; None
     for the linear law), the rate 1 / (R E D) ``rate`` and d ln A / dt ``decay``. ``phase_integral``:
-    (grid, int dt / (R E D) from the reference time, phi0, omega0, the end rates); ``law_slopes`` that
+    (grid, int dt / (R E D) from the reference time, the end rates); ``law_slopes`` that
     integral's response to each law parameter, ``law_prior_sd`` their priors' sds (for :mod:`.bound`).
     ``order_shift``, ``held_shift``, ``ideal_shift`` (rad/s) and ``rises``: the law's doubts that
     :meth:`.phase_law.Model.check_law` measures (zero before it).
@@ -46,7 +46,6 @@ class PhaseFit:
 
     names: tuple[str, ...]
     params: np.ndarray
-    omega0: float
     cov_stat: np.ndarray
     cov_law: np.ndarray
     prior_gain: np.ndarray
@@ -74,6 +73,16 @@ class PhaseFit:
     ideal_shift: float = 0.0  # the same, whatever the conflict: what a law shared with other records weighs
     rises: bool = False  # the cycles' envelope rises again (.near.envelope_rises): a mode beating in
 
+    @property
+    def phi0(self) -> float:
+        """The phase (rad) at the reference time."""
+        return float(self.params[0])
+
+    @property
+    def omega0(self) -> float:
+        """The zero-swing frequency (rad/s): 2 pi / T0."""
+        return float(self.params[1])
+
     def fund_at(self, tt: np.ndarray) -> np.ndarray:
         """The cycles' envelope (signal units; the angle's for a rate) at times ``tt``."""
         return np.interp(tt, self.grid, self.amplitude)
@@ -89,8 +98,7 @@ class PhaseFit:
     def integral_at(self, tt: np.ndarray) -> np.ndarray:
         """int dt / (R E D) from the reference time to ``tt`` (s), carried on at the end rates beyond the
         first and last cycle: the phase is phi0 + omega0 times this."""
-        grid, cum, _, _, g0, g1 = self.phase_integral
-        return _carried(tt, grid, cum, g0, g1)
+        return _carried(tt, *self.phase_integral)
 
     def law_integrals_at(self, tt: np.ndarray) -> np.ndarray:
         """d :meth:`integral_at` / d p for each law parameter p (``names[2:]``), an (n, m) array."""
@@ -98,8 +106,7 @@ class PhaseFit:
 
     def phase_at(self, tt: np.ndarray) -> np.ndarray:
         """The fitted law's phase Phi at times ``tt`` (the cycles' fundamental is A cos Phi)."""
-        _, _, phi, omega, _, _ = self.phase_integral
-        return phi + omega * self.integral_at(tt)
+        return self.phi0 + self.omega0 * self.integral_at(tt)
 
     def local_omega(self, tt: np.ndarray) -> np.ndarray:
         """The instantaneous frequency (rad/s) the fitted law gives at times ``tt``."""

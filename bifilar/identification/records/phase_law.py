@@ -258,14 +258,13 @@ class Model:
             conflict = float(np.max(np.abs(p[2:2 + len(EXCESS_TERMS)] @ powers) / np.maximum(sd, 1e-300)))
         cov_stat, cov_law, prior_gain = _covariance(j_phase, jp, r_phase, j_envelope, envelope.cov, "ds" in names)
         return PhaseFit(
-            names=tuple(names), params=p, omega0=float(p[1]), cov_stat=cov_stat, cov_law=cov_law,
+            names=tuple(names), params=p, cov_stat=cov_stat, cov_law=cov_law,
             prior_gain=prior_gain, residual=r_phase / weights, var=var, ideal=s if law_on else None,
             conflict=conflict, held=held, scale_known=self.kind != "proportional" or "kappa" in names or "q" in names,
             damping=damping, shift_curve=shift_curve, harmonic=harmonic, table=table, table_key=table_key,
             grid=grid, amplitude=amp_grid, peak=a_fit if law_on else None, rate=g_fit,
             decay=envelope.basis(grid, derivative=1) @ envelope.beta,
-            phase_integral=(grid, _from_reference(grid, g_fit, at_ref), float(p[0]), float(p[1]), float(g_fit[0]),
-                            float(g_fit[-1])),
+            phase_integral=(grid, _from_reference(grid, g_fit, at_ref), float(g_fit[0]), float(g_fit[-1])),
             # the integral's response to each law parameter (names[2:]) and their priors' sds, for the
             # Cramér-Rao bound of a whole fit with the law free (:mod:`.bound`)
             law_slopes=tuple((grid, _from_reference(grid, d, at_ref), float(d[0]), float(d[-1])) for d in terms(p)[3]),

@@ -75,8 +75,7 @@ def fit_whole(rec: Samples, cyc: Cycles, law_fit: PhaseFit, baseline: np.ndarray
     envelope = law_fit.fund_at(tau) * (law_fit.local_omega(tau) if rec.kind == "rate" else 1.0)
     level = float(np.exp(np.mean(np.log(envelope))))
     harmonics = highest_harmonic(float(np.median([len(cyc.index[k]) for k in good])))
-    _, _, phi0, omega0, _, _ = law_fit.phase_integral
-    first = [phi0, omega0, math.log(float(np.median(cyc.fundamental[good])) / level), 0.0]
+    first = [law_fit.phi0, law_fit.omega0, math.log(float(np.median(cyc.fundamental[good])) / level), 0.0]
     largest = _SECOND_SHARE * float(np.max(envelope))
     swept = swept_band(law_fit, cyc.centre[good])
 
