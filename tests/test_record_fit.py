@@ -354,8 +354,9 @@ def test_damping_shift_is_its_equation_integrated(damping):
 @pytest.mark.parametrize("samples", [40, 1024])
 def test_the_periodogram_is_scipys_floating_mean_lomb_scargle(samples):
     """records.cycles.periodogram takes the tau-shifted sums from the unshifted ones (angle-sum
-    identities) instead of evaluating the trigonometry twice: scipy's values to rounding, on unevenly
-    spaced samples with an offset, a drift and noise."""
+    identities) and, on an evenly spaced grid, the phasors from products of a few evaluated ones instead
+    of evaluating the trigonometry at every entry twice: scipy's values to rounding, on unevenly spaced
+    samples with an offset, a drift and noise, on an even and an uneven grid of frequencies."""
     from scipy.signal import lombscargle
 
     from bifilar.identification.records.cycles import periodogram
@@ -364,8 +365,10 @@ def test_the_periodogram_is_scipys_floating_mean_lomb_scargle(samples):
     x = np.sort(rng.uniform(0.0, 60.0, samples))
     y = 0.7 * np.cos(3.1 * x + 0.3) * np.exp(-0.01 * x) + 0.2 + 0.01 * x + 0.05 * rng.standard_normal(samples)
     grid = np.arange(0.1, math.pi * (samples - 1) / 60.0, math.pi / 60.0)
-    reference = lombscargle(x, y, grid, floating_mean=True)
-    np.testing.assert_allclose(periodogram(x, y, grid), reference, rtol=0, atol=1e-12 * reference.max())
+    uneven = np.sort(rng.uniform(0.1, grid[-1], len(grid)))  # the phasors evaluated directly
+    for omega in (grid, uneven):
+        reference = lombscargle(x, y, omega, floating_mean=True)
+        np.testing.assert_allclose(periodogram(x, y, omega), reference, rtol=0, atol=1e-12 * reference.max())
 
 
 @pytest.mark.parametrize("zeta", [1e-3, 0.02])
