@@ -438,3 +438,26 @@ def test_a_law_no_rig_has_is_flagged_by_identify():
     flags = " ".join(trials[0].flags)
     assert trials[0].fit.law.conflict > 3.0
     assert "more than a real rig's" in flags and "the rig file" in flags and "known to" in flags
+
+
+def test_the_baseline_smoother_is_a_running_weighted_straight_line():
+    """records.cycles.smooth takes the local line from its weighted sums at every point at once: numpy's
+    weighted polyfit at each point to rounding (1e-10 of the values: the normal equations of a line
+    through a few close points lose a few digits), a lone point in reach its own value, none the
+    interpolation."""
+    from bifilar.identification.records.cycles import smooth
+
+    rng = np.random.default_rng(7)
+    x = np.sort(rng.uniform(0.0, 50.0, 60))
+    y = 0.4 + 0.01 * x + 0.01 * rng.standard_normal(60)
+    at = np.linspace(-5.0, 60.0, 300)
+    for width in (0.3, 2.0, 10.0):
+        w = np.clip(1.0 - np.abs((x[None, :] - at[:, None]) / width) ** 3, 0.0, None) ** 3
+        expected = []
+        for i, a in enumerate(at):
+            keep = w[i] > 0.0
+            if keep.sum() >= 2:
+                expected.append(np.polyval(np.polyfit(x[keep] - a, y[keep], 1, w=np.sqrt(w[i, keep])), 0.0))
+            else:
+                expected.append(y[keep][0] if keep.any() else np.interp(a, x, y))
+        np.testing.assert_allclose(smooth(x, y, at, width), expected, rtol=0, atol=1e-10)

@@ -336,22 +336,16 @@ def baseline_of(tau: np.ndarray, cyc: Cycles) -> np.ndarray:
     return np.interp(tau, at, smooth(x, cyc.offset[g], at, width))
 
 
-def smooth(x: np.ndarray, y: np.ndarray, at: np.ndarray, width: float, degree: int = 1) -> np.ndarray:
-    """Local polynomial regression (``degree`` 1 or 2) of ``y`` on ``x`` at the points ``at`` with
-    tricube weights over +- ``width``: a running straight line (exact for a linear trend) or parabola
-    (its bias a fourth-order term in width: a decaying amplitude's curvature does not bias it), where
-    too few points are in reach the lower degree."""
-    d = x[None, :] - at[:, None]
-    u = np.abs(d) / width
-    w = np.where(u < 1.0, (1.0 - u**3) ** 3, 0.0)
-    out = np.empty(len(at))
-    for i in range(len(at)):
-        keep = w[i] > 0.0
-        k = min(degree, int(keep.sum()) - 1)
-        if k < 0:
-            out[i] = float(np.interp(at[i], x, y))
-            continue
-        basis = np.vander(d[i, keep] / width, k + 1, increasing=True)
-        sw = np.sqrt(w[i, keep])
-        out[i] = np.linalg.lstsq(basis * sw[:, None], y[keep] * sw, rcond=None)[0][0]
-    return out
+def smooth(x: np.ndarray, y: np.ndarray, at: np.ndarray, width: float) -> np.ndarray:
+    """Local linear regression of ``y`` on ``x`` at the points ``at`` with tricube weights over +-
+    ``width``: a running straight line (exact for a linear trend), from its weighted sums at every point
+    at once; where one point is in reach its value, where none the interpolation of ``y``."""
+    d = (x[None, :] - at[:, None]) / width
+    w = np.where(np.abs(d) < 1.0, (1.0 - np.abs(d) ** 3) ** 3, 0.0)
+    wd = w * d
+    s0, s1, s2 = w.sum(axis=1), wd.sum(axis=1), (wd * d).sum(axis=1)
+    t0, t1 = w @ y, wd @ y
+    det = s0 * s2 - s1 * s1
+    count = np.count_nonzero(w, axis=1)
+    line = (s2 * t0 - s1 * t1) / np.where(count >= 2, det, 1.0)
+    return np.where(count >= 2, line, np.where(count == 1, t0 / np.where(count == 1, s0, 1.0), np.interp(at, x, y)))
