@@ -6,8 +6,9 @@ set the sigma (a 95 % test: ~5 % where the covariance is honest).
 
     PYTHONPATH=. python benchmarks/trial_width.py COUNT [CONFIGURATIONS, default 0,2,5,7]
 
-Measured on stop 47's code (30 trials each): configurations 0, 2, 5: sd / sigma 0.69, 0.75, 0.63; the
-jackknife set the sigma in 60 %, 3 % and 20 % of the trials (docs/identification.md, "What is left").
+Measured on stop 47's code (30 trials each): configurations 0, 2, 5, 7: sd / sigma 0.69, 0.75, 0.63,
+0.63; the jackknife set the sigma in 60 %, 3 %, 20 % and 47 % of the trials (docs/identification.md,
+"What is left").
 """
 
 import math
