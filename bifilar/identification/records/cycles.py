@@ -341,7 +341,8 @@ def smooth(x: np.ndarray, y: np.ndarray, at: np.ndarray, width: float) -> np.nda
     ``width``: a running straight line (exact for a linear trend), from its weighted sums at every point
     at once; where one point is in reach its value, where none the interpolation of ``y``."""
     d = (x[None, :] - at[:, None]) / width
-    w = np.where(np.abs(d) < 1.0, (1.0 - np.abs(d) ** 3) ** 3, 0.0)
+    u = np.abs(d)
+    w = np.where(u < 1.0, (1.0 - u**3) ** 3, 0.0)
     wd = w * d
     s0, s1, s2 = w.sum(axis=1), wd.sum(axis=1), (wd * d).sum(axis=1)
     t0, t1 = w @ y, wd @ y

@@ -87,11 +87,11 @@ def record(rig: L.TorsionRig, rng: np.random.Generator, traits: Traits) -> Synth
     t0 = L.linear_period(rig)
     omega = 2.0 * math.pi / t0
     span = tr.cycles * t0 * (1.0 + 0.2 * tr.amplitude**2)
-    frames = np.arange(int(span * tr.rate))
-    n = len(frames)
-    t = frames / tr.rate
     rate_out = tr.kind == "rate"
     clean = _clean(rig, span, tr.amplitude, tr.excess, tr.shape, tr.zeta, tr.quadratic, tr.dry, tr.rate, rate_out)
+    n = len(clean)
+    frames = np.arange(n)
+    t = frames / tr.rate
     if tr.second is not None:
         ratio, rel, decay = tr.second
         w2, phase, a2 = omega / ratio, rng.uniform(0.0, 2.0 * math.pi), rel * tr.amplitude
@@ -147,7 +147,7 @@ def _motion(rig: L.TorsionRig, span: float, amplitude: float, excess: float, sha
 def _clean(rig: L.TorsionRig, span: float, amplitude: float, excess: float, shape: float, zeta: float,
            quadratic: float, dry: float, rate: float, rate_out: bool) -> np.ndarray:
     """The clean motion's angle (rate: its rate) at every frame of ``rate`` frames/s over ``span``
-    (read-only). Kept for the last few: a study drawing many records of one motion (new noise each)
+    (read-only; frame k at k / rate s: its length is the record's frame count). Kept for the last few: a study drawing many records of one motion (new noise each)
     evaluates the dense solution's ~37 pieces a cycle once, ~0.1 s of a 100-cycle record."""
     sol = _motion(rig, span, amplitude, excess, shape, zeta, quadratic, dry)
     clean = sol(np.arange(int(span * rate)) / rate)[1 if rate_out else 0]
