@@ -4,6 +4,14 @@ numba hands ``@`` and ``np.linalg.solve`` to BLAS/LAPACK, whose call overhead (~
 arithmetic of a 3x5 or 5x5 problem; plain loops compile to a few nanoseconds. Likewise numba's
 ``np.cross`` is generic (any shapes, broadcast along an axis) and costs more to compile than the three
 products it computes for two 3-vectors: :func:`cross` writes them out, with the same arithmetic.
+
+Compiling weighs as much as running: in a fresh process a kernel's first ``np.linalg.solve`` costs
+~2.5 s of compile CPU (numba's LAPACK machinery), a matrix right-hand side 1.45 s more, ``inv`` and
+``cholesky`` each their own wrapper, and every ``@`` ~0.4 s per new combination of operand types (a
+1-D ``a @ b`` too), paid again in every entry point that links the kernel in. :func:`dot`,
+:func:`inverse` and :func:`cholesky` are their loop versions for the few-by-few matrices of the
+rigid-body kernels; rank-deficient problems (least squares with a cut-off, SVD, eigen-solves) stay
+with LAPACK.
 """
 
 import numpy as np
@@ -14,6 +22,15 @@ from numba import njit
 def cross(a, b):
     """a x b of two 3-vectors, written out (the same products and order as ``np.cross``)."""
     return np.array([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
+
+
+@njit(cache=True)
+def dot(a, b):
+    """a . b of two 1-D arrays with a loop (numba sends a 1-D ``@`` to BLAS)."""
+    acc = 0.0
+    for k in range(a.shape[0]):
+        acc += a[k] * b[k]
+    return acc
 
 
 @njit(cache=True)
@@ -64,3 +81,60 @@ def solve(A, b):
             acc -= M[i, j] * x[j]
         x[i] = acc / M[i, i]
     return x
+
+
+@njit(cache=True)
+def inverse(A):
+    """A^-1 by Gauss-Jordan elimination with partial pivoting, failing as numba's ``np.linalg.inv``
+    does (LAPACK getrf/getri): LinAlgError on an input not finite or an exactly zero pivot."""
+    n = A.shape[0]
+    M = A.copy()
+    X = np.eye(n)
+    for k in range(n):
+        for j in range(n):
+            if not np.isfinite(M[k, j]):
+                raise np.linalg.LinAlgError("Array must not contain infs or NaNs.")
+    for k in range(n):
+        piv = k
+        for i in range(k + 1, n):
+            if abs(M[i, k]) > abs(M[piv, k]):
+                piv = i
+        if M[piv, k] == 0.0:
+            raise np.linalg.LinAlgError("Matrix is singular to machine precision.")
+        if piv != k:
+            for j in range(n):
+                M[k, j], M[piv, j] = M[piv, j], M[k, j]
+                X[k, j], X[piv, j] = X[piv, j], X[k, j]
+        d = 1.0 / M[k, k]
+        for j in range(n):
+            M[k, j] *= d
+            X[k, j] *= d
+        for i in range(n):
+            f = M[i, k]
+            if i == k or f == 0.0:
+                continue
+            for j in range(n):
+                M[i, j] -= f * M[k, j]
+                X[i, j] -= f * X[k, j]
+    return X
+
+
+@njit(cache=True)
+def cholesky(A):
+    """Lower-triangular L with A = L L^T of a symmetric positive definite A (its lower triangle read),
+    failing as numba's ``np.linalg.cholesky`` does: LinAlgError where A is not positive definite."""
+    n = A.shape[0]
+    L = np.zeros((n, n))
+    for j in range(n):
+        acc = A[j, j]
+        for k in range(j):
+            acc -= L[j, k] * L[j, k]
+        if not acc > 0.0:
+            raise np.linalg.LinAlgError("Matrix is not positive definite.")
+        L[j, j] = np.sqrt(acc)
+        for i in range(j + 1, n):
+            acc = A[i, j]
+            for k in range(j):
+                acc -= L[i, k] * L[j, k]
+            L[i, j] = acc / L[j, j]
+    return L

@@ -27,7 +27,7 @@ import numba as nb
 import numpy as np
 
 from bifilar.rig import pose_kernel
-from bifilar.smallmat import mm, mv
+from bifilar.smallmat import inverse, mm, mv
 
 _SINGULAR = 1e-10  # smallest / largest singular value of the equilibrium Jacobian treated as singular
 _CHORD_STEPS = 2
@@ -91,7 +91,7 @@ def projector(jac):
     The products are :mod:`bifilar.smallmat`'s loops: numba's ``@`` compiles a BLAS path per operand
     layout, and J^T is another layout than J."""
     jac_t = jac.T.copy()
-    out = -mm(jac_t, np.linalg.solve(mm(jac, jac_t), jac))
+    out = -mm(jac_t, mm(inverse(mm(jac, jac_t)), jac))
     for k in range(6):
         out[k, k] += 1.0
     return out
@@ -127,7 +127,7 @@ def period_slopes(x, h, n_wires, gravity, scale, com0, rot0, t0, inertias, shape
     sv = np.linalg.svd(jac_eq)[1]
     if not sv[-1] > _SINGULAR * sv[0]:
         return out, False
-    inverse = np.linalg.inv(jac_eq)
+    inv_eq = inverse(jac_eq)
     jac, k6 = tangent_matrices(com0, rot0, t0, arms, anchors, mass)
     proj = projector(jac)
     base = np.empty(n_axes)
@@ -144,7 +144,7 @@ def period_slopes(x, h, n_wires, gravity, scale, com0, rot0, t0, inertias, shape
         com, rot, tn = com0.copy(), rot0.copy(), t0 / weight
         for _ in range(_CHORD_STEPS):
             res = pose_kernel.equilibrium_balance(com, rot, tn * weight, arms, anchors, lengths, weight, scale)
-            step = -mv(inverse, res)
+            step = -mv(inv_eq, res)
             com += step[:3]
             rot = mm(pose_kernel.rotation_vector_matrix(step[3:6]), rot)
             tn += step[6:]
