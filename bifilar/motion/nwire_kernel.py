@@ -23,7 +23,6 @@ from numba import njit
 from bifilar.motion.kane_kernel import P_AIR as AIR_FLAG
 from bifilar.motion.kane_kernel import air_terms
 from bifilar.smallmat import cross as _cross
-from bifilar.smallmat import dot, inverse, mm, mv
 
 STATE_SIZE = 13
 
@@ -31,7 +30,7 @@ STATE_SIZE = 13
 @njit(cache=True)
 def quat_matrix(q):
     """Rotation matrix of a quaternion (scalar first), normalised first."""
-    n = np.sqrt(dot(q, q))
+    n = np.sqrt(q @ q)
     w, x, y, z = q[0] / n, q[1] / n, q[2] / n, q[3] / n
     return np.array([
         [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
@@ -74,8 +73,8 @@ def dynamics(y, arms, anchors, inertia_body, mass, gravity, air):
     matrix and its velocity terms and drag the applied wrench, exactly as in the Kane model
     (``kane_kernel.air_terms``); in a vacuum the block-diagonal path below runs unchanged."""
     minv_f, minv_jt, jac, b, rho = _system(y, arms, anchors, inertia_body, mass, gravity, air)
-    tension = mv(inverse(mm(jac, minv_jt)), mv(jac, minv_f) - b)
-    acc = minv_f - mv(minv_jt, tension)
+    tension = np.linalg.solve(jac @ minv_jt, jac @ minv_f - b)
+    acc = minv_f - minv_jt @ tension
     return acc, tension, jac, rho
 
 
@@ -89,10 +88,10 @@ def compatible_tensions(y, arms, anchors, inertia_body, mass, gravity, air, spri
     wires' stretch allows, and the self-stress of ``base`` (the part no motion of the body changes to first
     order) is kept: what :func:`dynamics` cannot solve (issue 35 item 5)."""
     minv_f, minv_jt, jac, b, _ = _system(y, arms, anchors, inertia_body, mass, gravity, air)
-    a = mm(jac, minv_jt)
+    a = jac @ minv_jt
     stretch = jac * springs.reshape(-1, 1)  # K J
-    d = np.linalg.lstsq(mm(a, stretch), mv(jac, minv_f) - b - mv(a, base), 1e-10)[0]
-    return base + mv(stretch, d)
+    d = np.linalg.lstsq(a @ stretch, jac @ minv_f - b - a @ base, 1e-10)[0]
+    return base + stretch @ d
 
 
 @njit(cache=True)
@@ -102,25 +101,24 @@ def _system(y, arms, anchors, inertia_body, mass, gravity, air):
     n = arms.shape[0]
     c, v, om = y[0:3], y[7:10], y[10:13]
     rot = quat_matrix(y[3:7])
-    rot_t = rot.T.copy()
-    iw = mm(mm(rot, inertia_body), rot_t)
-    iw_inv = mm(mm(rot, inverse(inertia_body)), rot_t)
+    iw = rot @ inertia_body @ rot.T
+    iw_inv = rot @ np.linalg.inv(inertia_body) @ rot.T
     jac = np.empty((n, 6))
     b = np.empty(n)
     rho = np.empty(n)
     for i in range(n):
-        s = mv(rot, arms[i])
+        s = rot @ arms[i]
         d = anchors[i] - c - s
-        rho[i] = np.sqrt(dot(d, d))
+        rho[i] = np.sqrt(d @ d)
         u = d / rho[i]
         w = v + _cross(om, s)
-        uw = dot(u, w)
+        uw = u @ w
         jac[i, :3] = -u
         jac[i, 3:] = _cross(u, s)
-        b[i] = dot(u, _cross(om, _cross(om, s))) - (dot(w, w) - uw * uw) / rho[i]
+        b[i] = u @ _cross(om, _cross(om, s)) - (w @ w - uw * uw) / rho[i]
     f = np.zeros(6)
     f[2] = -mass * gravity
-    f[3:] = -_cross(om, mv(iw, om))
+    f[3:] = -_cross(om, iw @ om)
     minv_f = np.empty(6)
     minv_jt = np.empty((6, n))
     if air[AIR_FLAG] != 0.0:
@@ -130,16 +128,16 @@ def _system(y, arms, anchors, inertia_body, mass, gravity, air):
             m6[k, k] += mass
         m6[3:, 3:] += iw
         f += drag - bias
-        m6_inv = inverse(m6)
-        minv_f[:] = mv(m6_inv, f)
-        minv_jt[:, :] = mm(m6_inv, jac.T.copy())
+        m6_inv = np.linalg.inv(m6)
+        minv_f[:] = m6_inv @ f
+        minv_jt[:, :] = m6_inv @ jac.T
     else:
         # M^-1 applied to f and to each row of J (as columns of M^-1 J^T).
         minv_f[:3] = f[:3] / mass
-        minv_f[3:] = mv(iw_inv, f[3:])
+        minv_f[3:] = iw_inv @ f[3:]
         for i in range(n):
             minv_jt[:3, i] = jac[i, :3] / mass
-            minv_jt[3:, i] = mv(iw_inv, jac[i, 3:])
+            minv_jt[3:, i] = iw_inv @ jac[i, 3:]
     return minv_f, minv_jt, jac, b, rho
 
 
@@ -150,9 +148,9 @@ def dynamics_jacobian(y, arms, anchors):
     rot = quat_matrix(y[3:7])
     jac = np.empty((n, 6))
     for i in range(n):
-        s = mv(rot, arms[i])
+        s = rot @ arms[i]
         d = anchors[i] - y[0:3] - s
-        u = d / np.sqrt(dot(d, d))
+        u = d / np.sqrt(d @ d)
         jac[i, :3] = -u
         jac[i, 3:] = _cross(u, s)
     return jac
@@ -193,9 +191,9 @@ def observe(Y, arms, anchors, inertia_body, mass, gravity, air):
         frames[k] = rot
         ten[k] = dynamics(y, arms, anchors, inertia_body, mass, gravity, air)[1]
         om, v = y[10:13], y[7:10]
-        iw = mm(mm(rot, inertia_body), rot.T.copy())
-        energy[k] = 0.5 * mass * dot(v, v) + 0.5 * dot(om, mv(iw, om)) + mass * gravity * y[2]
+        iw = rot @ inertia_body @ rot.T
+        energy[k] = 0.5 * mass * (v @ v) + 0.5 * (om @ (iw @ om)) + mass * gravity * y[2]
         if air[AIR_FLAG] != 0.0:
             x = np.concatenate((v, om))
-            energy[k] += 0.5 * dot(x, mv(air_terms(rot, v, om, air)[0], x))
+            energy[k] += 0.5 * (x @ (air_terms(rot, v, om, air)[0] @ x))
     return frames, ten, energy
