@@ -5,13 +5,12 @@ arithmetic of a 3x5 or 5x5 problem; plain loops compile to a few nanoseconds. Li
 ``np.cross`` is generic (any shapes, broadcast along an axis) and costs more to compile than the three
 products it computes for two 3-vectors: :func:`cross` writes them out, with the same arithmetic.
 
-Compiling weighs as much as running: in a fresh process a kernel's first ``np.linalg.solve`` costs
-~2.5 s of compile CPU (numba's LAPACK machinery), a matrix right-hand side 1.45 s more, ``inv`` and
-``cholesky`` each their own wrapper, and every ``@`` ~0.4 s per new combination of operand types (a
-1-D ``a @ b`` too), paid again in every entry point that links the kernel in. :func:`dot`,
-:func:`inverse` and :func:`cholesky` are their loop versions for the few-by-few matrices of the
-rigid-body kernels; rank-deficient problems (least squares with a cut-off, SVD, eigen-solves) stay
-with LAPACK.
+:func:`inverse` is there for compile time: numba's ``np.linalg.inv`` and its ``solve`` with a matrix
+right-hand side each compile their own LAPACK wrapper into the kernel that calls them. In
+``slopes_kernel.period_slopes`` the loop version cut that kernel's compile from 5.8 to 4.5 CPU s
+(``benchmarks/compile_cpu.py``); where a kernel keeps other LAPACK calls (SVD, least squares,
+eigen-solves: rank handling LAPACK does and these loops do not) the process's LAPACK set-up is paid
+anyway, and swapping a lone ``solve`` or ``@`` for loops measured no gain.
 """
 
 import numpy as np
@@ -22,15 +21,6 @@ from numba import njit
 def cross(a, b):
     """a x b of two 3-vectors, written out (the same products and order as ``np.cross``)."""
     return np.array([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
-
-
-@njit(cache=True)
-def dot(a, b):
-    """a . b of two 1-D arrays with a loop (numba sends a 1-D ``@`` to BLAS)."""
-    acc = 0.0
-    for k in range(a.shape[0]):
-        acc += a[k] * b[k]
-    return acc
 
 
 @njit(cache=True)
@@ -118,23 +108,3 @@ def inverse(A):
                 X[i, j] -= f * X[k, j]
     return X
 
-
-@njit(cache=True)
-def cholesky(A):
-    """Lower-triangular L with A = L L^T of a symmetric positive definite A (its lower triangle read),
-    failing as numba's ``np.linalg.cholesky`` does: LinAlgError where A is not positive definite."""
-    n = A.shape[0]
-    L = np.zeros((n, n))
-    for j in range(n):
-        acc = A[j, j]
-        for k in range(j):
-            acc -= L[j, k] * L[j, k]
-        if not acc > 0.0:
-            raise np.linalg.LinAlgError("Matrix is not positive definite.")
-        L[j, j] = np.sqrt(acc)
-        for i in range(j + 1, n):
-            acc = A[i, j]
-            for k in range(j):
-                acc -= L[i, k] * L[j, k]
-            L[i, j] = acc / L[j, j]
-    return L

@@ -89,7 +89,8 @@ def mass_matrix(rot, inertia, mass, air_body, air):
 def projector(jac):
     """I - J^T (J J^T)^-1 J: the projection (6 x 6) onto the null space of the constraint gradients.
     The products are :mod:`bifilar.smallmat`'s loops: numba's ``@`` compiles a BLAS path per operand
-    layout, and J^T is another layout than J."""
+    layout, and J^T is another layout than J; (J J^T)^-1 too (a LAPACK solve with a matrix right-hand side
+    compiles its own wrapper: see :mod:`bifilar.smallmat`)."""
     jac_t = jac.T.copy()
     out = -mm(jac_t, mm(inverse(mm(jac, jac_t)), jac))
     for k in range(6):
@@ -127,7 +128,7 @@ def period_slopes(x, h, n_wires, gravity, scale, com0, rot0, t0, inertias, shape
     sv = np.linalg.svd(jac_eq)[1]
     if not sv[-1] > _SINGULAR * sv[0]:
         return out, False
-    inv_eq = inverse(jac_eq)
+    inv_eq = inverse(jac_eq)  # a loop inverse (bifilar.smallmat): numba's inv compiles another LAPACK wrapper
     jac, k6 = tangent_matrices(com0, rot0, t0, arms, anchors, mass)
     proj = projector(jac)
     base = np.empty(n_axes)

@@ -23,10 +23,17 @@ from bifilar.motion.kane_kernel import P_AIR as AIR_FLAG
 from bifilar.motion.kane_kernel import air_terms
 from bifilar.motion.nwire_kernel import STATE_SIZE, quat_matrix, state_rate
 from bifilar.smallmat import cross as _cross
-from bifilar.smallmat import dot as _dot
-from bifilar.smallmat import inverse
 from bifilar.smallmat import mm as _mm
 from bifilar.smallmat import mv as _mv
+
+
+@njit(cache=True)
+def _dot(a, b):
+    """a . b with a loop: numba sends a 1-D ``@`` to BLAS, a call (and a compile) dearer than the sum."""
+    acc = 0.0
+    for k in range(a.shape[0]):
+        acc += a[k] * b[k]
+    return acc
 
 
 @njit(cache=True)
@@ -56,11 +63,11 @@ def dynamics(y, arms, anchors, lengths, springs, inertia_body, mass, gravity, ai
         for k in range(3):
             m6[k, k] += mass
         m6[3:, 3:] += iw
-        acc = _mv(inverse(m6), f + drag - bias)
+        acc = np.linalg.solve(m6, f + drag - bias)
     else:
         acc = np.empty(6)
         acc[:3] = f[:3] / mass
-        acc[3:] = _mv(inverse(iw), f[3:])
+        acc[3:] = np.linalg.solve(iw, f[3:])
     return acc, tension, stretch
 
 

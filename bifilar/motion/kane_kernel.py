@@ -39,7 +39,6 @@ from numba import njit
 from bifilar.rig.air import drag_wrench
 from bifilar.jit import announce_compile
 from bifilar.smallmat import cross as _cross
-from bifilar.smallmat import dot as _dot
 from bifilar.smallmat import mm as _mm
 from bifilar.smallmat import mv as _mv
 from bifilar.smallmat import solve as _solve
@@ -207,7 +206,7 @@ def eom(th, dth, p, chart):
         N5[:4] += _mv(Pn6T, drag - b - _mv(maw, np.concatenate((vbias, wbias))))
     M5[4, :] = beta
     ddot = _mv(J, dth)
-    N5[4] = -2.0 * (_dot(ddot, ddot) + _dot(d, dbias))
+    N5[4] = -2.0 * (ddot @ ddot + d @ dbias)
     return M5, N5
 
 
@@ -249,7 +248,7 @@ def loads(th, dth, p, chart):
     omega = _mv(G, dth)
     Iw = inertia_world(R, p)
     e1 = -u  # from C towards B
-    e2 = -d / np.sqrt(_dot(d, d))  # from D towards A
+    e2 = -d / np.sqrt(d @ d)  # from D towards A
     arm_c = -r  # R* -> C
     arm_d = -r - bp * R[:, 2]  # R* -> D = R* -> C + CD
     A = np.empty((6, 2))
@@ -267,7 +266,7 @@ def loads(th, dth, p, chart):
     At = A.T.copy()
     tension = _solve(_mm(At, A), _mv(At, rhs_))
     res = _mv(A, tension) - rhs_
-    return tension, acc, alpha, np.sqrt(_dot(res, res))
+    return tension, acc, alpha, np.sqrt(res @ res)
 
 
 @njit(cache=True)
@@ -293,12 +292,12 @@ def observe(Y, p, chart):
         vel[i] = _mv(V, dth)
         omg[i] = _mv(G, dth)
         tension[i] = loads(th, dth, p, chart)[0]
-        err2[i] = np.sqrt(_dot(d, d)) - p[P_LP]
+        err2[i] = np.sqrt(d @ d) - p[P_LP]
         Iw = inertia_world(R, p)
-        energy[i] = 0.5 * m * _dot(vel[i], vel[i]) + 0.5 * _dot(omg[i], _mv(Iw, omg[i])) + m * g * c[2]
+        energy[i] = 0.5 * m * (vel[i] @ vel[i]) + 0.5 * (omg[i] @ _mv(Iw, omg[i])) + m * g * c[2]
         if p[P_AIR] != 0.0:  # plus the fluid's kinetic energy 1/2 x^T M_A,w x
             x = np.concatenate((vel[i], omg[i]))
-            energy[i] += 0.5 * _dot(x, _mv(air_terms(R, vel[i], omg[i], p)[0], x))
+            energy[i] += 0.5 * (x @ _mv(air_terms(R, vel[i], omg[i], p)[0], x))
     return com, frames, vel, omg, tension, err2, energy
 
 

@@ -43,7 +43,6 @@ from scipy.spatial.transform import Rotation
 from scipy.special import elliprd
 
 from bifilar.rig.checks import RigError, no_unknown, non_negative, positive, required, vector3
-from bifilar.smallmat import dot
 
 SHAPES = ("ellipsoid", "box")
 DRAG_DEFAULT = (0.5, 0.25, 1.5)  # MuJoCo's fluidcoef[0:3] defaults: blunt, slender, angular
@@ -170,7 +169,7 @@ def drag_wrench(v, w, q):
     r_max, r_min = r.max(), r.min()
     r_mid = r.sum() - r_max - r_min
     r_d = r.sum() / 3.0
-    speed = np.sqrt(dot(v, v))
+    speed = np.sqrt(v @ v)
     force = -6.0 * np.pi * mu * r_d * v
     if speed > 0.0:
         u = v / speed
@@ -185,5 +184,5 @@ def drag_wrench(v, w, q):
         i_d[i] = 8.0 * np.pi / 15.0 * r[i] * max(r[(i + 1) % 3], r[(i + 2) % 3]) ** 4
     i_max = i_d.max()
     mom = w * (c_angular * i_d + c_slender * (i_max - i_d))
-    torque = -rho * np.sqrt(dot(mom, mom)) * w - 8.0 * np.pi * mu * r_d**3 * w
+    torque = -rho * np.sqrt(mom @ mom) * w - 8.0 * np.pi * mu * r_d**3 * w
     return force, torque

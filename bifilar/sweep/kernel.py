@@ -24,7 +24,7 @@ from bifilar.motion import nwire_kernel as NK
 from bifilar.motion.modes import resolution  # the neutral and degenerate tests of linearize
 from bifilar.rig import pose_kernel
 from bifilar.rig.statics import NEWTON_ITERATIONS, RESIDUAL  # the same Newton as rest_pose
-from bifilar.smallmat import cholesky, inverse, mm, mv  # loops: see bifilar.smallmat
+from bifilar.smallmat import mm, mv  # loops: numba's `@` compiles a BLAS path per operand layout
 
 OK, NO_NEWTON, SLACK, NO_MODES, UNSTABLE, NEUTRAL, DEGENERATE = range(7)
 
@@ -49,7 +49,7 @@ def continued_modes(arms, anchors, lengths, mass, gravity, inertia, scale, com, 
     n = z.shape[1]
     if n == 0:
         return NO_MODES, com, rot, tensions, empty, np.zeros((6, 0))
-    chol_inv = inverse(cholesky(mr))
+    chol_inv = np.linalg.inv(np.linalg.cholesky(mr))
     a = mm(mm(chol_inv, kr), chol_inv.T.copy())
     w2, y = np.linalg.eigh(0.5 * (a + a.T))
     big = max(np.abs(w2).max(), 1e-300)
