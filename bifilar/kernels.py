@@ -39,25 +39,25 @@ class Group:
 GROUPS = {
     "kane": Group("bifilar.motion.kane_kernel", {
         "air_terms": "a2 a1 a1 a1", "rhs": "a1 a1 i", "observe": "a2 a1 i", "loads": "a1 a1 a1 i",
-        "eom": "a1 a1 a1 i", "pose": "a1 a1 i"}, 19.2),
+        "eom": "a1 a1 a1 i", "pose": "a1 a1 i"}, 22.6),
     "pose": Group("bifilar.rig.pose_kernel", {
         "newton_equilibrium": "a1 a2 a1 a2 a2 a1 f f i", "reduced_matrices": "a1 a2 a1 a2 a2 a2 f f f",
         "equilibrium_balance": "a1 a2 a1 a2 a2 a1 f f", "equilibrium_residual": "a1 a2 a1 a2 a2 a1 f f",
         "constraint_jacobian": "a2 a2", "constraint_hessian": "a2 a2 a1 i", "cross_matrix": "a1",
-        "rotation_vector_matrix": "a1", "wire_geometry": "a1 a2 a2 a2"}, 10.1),
+        "rotation_vector_matrix": "a1", "wire_geometry": "a1 a2 a2 a2"}, 12.3),
     "nwire": Group("bifilar.motion.nwire_kernel", {
         "rhs": "a1 a2 a2 a2 f f a1", "observe": "a2 a2 a2 a2 f f a1", "dynamics": "a1 a2 a2 a2 f f a1",
         "dynamics_jacobian": "a1 a2 a2", "quat_matrix": "a1", "matrix_quat": "a2", "state_rate": "a1 a1",
-        "compatible_tensions": "a1 a2 a2 a2 f f a1 a1 a1"}, 13.3),
+        "compatible_tensions": "a1 a2 a2 a2 f f a1 a1 a1"}, 15.6),
     "elastic": Group("bifilar.motion.elastic_kernel", {
-        "rhs": "a1 a2 a2 a1 a1 a2 f f a1", "observe": "a2 a2 a2 a1 a1 a2 f f a1"}, 5.6),
+        "rhs": "a1 a2 a2 a1 a1 a2 f f a1", "observe": "a2 a2 a2 a1 a1 a2 f f a1"}, 7.5),
     "slopes": Group("bifilar.identification.slopes_kernel", {
-        "period_slopes": "a1 a1 i f f a1 a2 a1 a3 a2 a2 a3"}, 5.3),
+        "period_slopes": "a1 a1 i f f a1 a2 a1 a3 a2 a2 a3"}, 4.7),
     "sweep": Group("bifilar.sweep.kernel", {
         "continued_modes": "a2 a2 a1 f f a2 f a1 a2 a1 f f f f",
-        "peak_tension": "a1 a2 a2 a1 a1 a1 a2 a2 a2 f f a1"}, 4.8),
-    "tmt": Group("bifilar.seeds.tmt", {"_kinematics": "a1 a1 a2 a2 i1 a1 i1 i"}, 4.4),
-    "damping": Group("bifilar.identification.records.damping", {"_cycle_from": "f f f f f"}, 0.6),
+        "peak_tension": "a1 a2 a2 a1 a1 a1 a2 a2 a2 f f a1"}, 6.6),
+    "tmt": Group("bifilar.seeds.tmt", {"_kinematics": "a1 a1 a2 a2 i1 a1 i1 i"}, 4.7),
+    "damping": Group("bifilar.identification.records.damping", {"_cycle_from": "f f f f f"}, 1.2),
     "modes": Group("bifilar.motion.modes", {"resolution": "f f f"}, 0.1),
 }
 
