@@ -115,10 +115,11 @@ def inverse(A):
 # shape-mismatch error message built by an f-string: ~2 CPU s the first time in a process and ~0.2 s
 # more per later kernel (6 such assignments compiled in 3.3-3.5 s, against 1.4-1.6 s through these
 # loops). The first-time part is saved only where no kernel of a process does it, so the kernels copy
-# with these instead (a row of a 2-D or 3-D array is passed as its view, ``put(rows[i], 0, x)``); the
-# project's groups compiled in 52.3 CPU s against 70.1 (``benchmarks/compile_cpu.py``). numba's own
-# ``np.linalg.solve`` and ``lstsq`` with a 1-D right-hand side still copy into a slice inside. A copy by
-# loop gives the same numbers, and ``out[k] = out[k] + x[k]`` is the same rounding as ``+=`` on a slice.
+# with these instead (a row of a 2-D or 3-D array is passed as its view, ``put(rows[i], 0, x)``): the
+# project's groups compiled in 53.9 CPU s against 59.5 in one process, each of two shares in 27-28 s
+# against 33-34 (``benchmarks/compile_cpu.py``, run back to back). numba's own ``np.linalg.solve`` and
+# ``lstsq`` with a 1-D right-hand side still copy into a slice inside. A copy by loop gives the same
+# numbers, and ``out[k] = out[k] + x[k]`` is the same rounding as ``+=`` on a slice.
 
 
 @njit(cache=True)
