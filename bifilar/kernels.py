@@ -39,25 +39,25 @@ class Group:
 GROUPS = {
     "kane": Group("bifilar.motion.kane_kernel", {
         "air_terms": "a2 a1 a1 a1", "rhs": "a1 a1 i", "observe": "a2 a1 i", "loads": "a1 a1 a1 i",
-        "eom": "a1 a1 a1 i", "pose": "a1 a1 i"}, 22.6),
+        "eom": "a1 a1 a1 i", "pose": "a1 a1 i"}, 15.9),
     "pose": Group("bifilar.rig.pose_kernel", {
         "newton_equilibrium": "a1 a2 a1 a2 a2 a1 f f i", "reduced_matrices": "a1 a2 a1 a2 a2 a2 f f f",
         "equilibrium_balance": "a1 a2 a1 a2 a2 a1 f f", "equilibrium_residual": "a1 a2 a1 a2 a2 a1 f f",
         "constraint_jacobian": "a2 a2", "constraint_hessian": "a2 a2 a1 i", "cross_matrix": "a1",
-        "rotation_vector_matrix": "a1", "wire_geometry": "a1 a2 a2 a2"}, 12.3),
+        "rotation_vector_matrix": "a1", "wire_geometry": "a1 a2 a2 a2"}, 9.5),
     "nwire": Group("bifilar.motion.nwire_kernel", {
         "rhs": "a1 a2 a2 a2 f f a1", "observe": "a2 a2 a2 a2 f f a1", "dynamics": "a1 a2 a2 a2 f f a1",
         "dynamics_jacobian": "a1 a2 a2", "quat_matrix": "a1", "matrix_quat": "a2", "state_rate": "a1 a1",
-        "compatible_tensions": "a1 a2 a2 a2 f f a1 a1 a1"}, 15.6),
+        "compatible_tensions": "a1 a2 a2 a2 f f a1 a1 a1"}, 10.7),
     "elastic": Group("bifilar.motion.elastic_kernel", {
-        "rhs": "a1 a2 a2 a1 a1 a2 f f a1", "observe": "a2 a2 a2 a1 a1 a2 f f a1"}, 7.5),
+        "rhs": "a1 a2 a2 a1 a1 a2 f f a1", "observe": "a2 a2 a2 a1 a1 a2 f f a1"}, 6.7),
     "slopes": Group("bifilar.identification.slopes_kernel", {
-        "period_slopes": "a1 a1 i f f a1 a2 a1 a3 a2 a2 a3"}, 4.7),
+        "period_slopes": "a1 a1 i f f a1 a2 a1 a3 a2 a2 a3"}, 4.0),
     "sweep": Group("bifilar.sweep.kernel", {
         "continued_modes": "a2 a2 a1 f f a2 f a1 a2 a1 f f f f",
-        "peak_tension": "a1 a2 a2 a1 a1 a1 a2 a2 a2 f f a1"}, 6.6),
-    "tmt": Group("bifilar.seeds.tmt", {"_kinematics": "a1 a1 a2 a2 i1 a1 i1 i"}, 4.7),
-    "damping": Group("bifilar.identification.records.damping", {"_cycle_from": "f f f f f"}, 1.2),
+        "peak_tension": "a1 a2 a2 a1 a1 a1 a2 a2 a2 f f a1"}, 4.6),
+    "tmt": Group("bifilar.seeds.tmt", {"_kinematics": "a1 a1 a2 a2 i1 a1 i1 i"}, 3.3),
+    "damping": Group("bifilar.identification.records.damping", {"_cycle_from": "f f f f f"}, 0.7),
     "modes": Group("bifilar.motion.modes", {"resolution": "f f f"}, 0.1),
 }
 

@@ -1,4 +1,5 @@
-"""Products and solves of small dense matrices inside numba-compiled kernels.
+"""Products and solves of small dense matrices inside numba-compiled kernels, and copies into parts of
+arrays (:func:`put` and its kin, for compile time: see the note above them).
 
 numba hands ``@`` and ``np.linalg.solve`` to BLAS/LAPACK, whose call overhead (~1 us) dwarfs the
 arithmetic of a 3x5 or 5x5 problem; plain loops compile to a few nanoseconds. Likewise numba's
@@ -108,3 +109,58 @@ def inverse(A):
                 X[i, j] -= f * X[k, j]
     return X
 
+
+# Copies into part of an array. numba compiles an array assigned into a slice (``out[:3] = x``,
+# ``m[3:, 3:] = R``, ``b[:3] += v``, ``rows[i] = vec``) through its generic ``fancy_setslice``, with a
+# shape-mismatch error message built by an f-string: ~2 CPU s the first time in a process and ~0.2 s
+# more per later kernel (6 such assignments compiled in 3.3-3.5 s, against 1.4-1.6 s through these
+# loops). The first-time part is saved only where no kernel of a process does it, so the kernels copy
+# with these instead (a row of a 2-D or 3-D array is passed as its view, ``put(rows[i], 0, x)``): the
+# project's groups compiled in 53.9 CPU s against 59.5 in one process, each of two shares in 27-28 s
+# against 33-34 (``benchmarks/compile_cpu.py``, run back to back). numba's own ``np.linalg.solve`` and
+# ``lstsq`` with a 1-D right-hand side still copy into a slice inside. A copy by loop gives the same
+# numbers, and ``out[k] = out[k] + x[k]`` is the same rounding as ``+=`` on a slice.
+
+
+@njit(cache=True)
+def put(out, i, x):
+    """out[i:i + len(x)] = x, as a loop (see the note above)."""
+    for k in range(x.shape[0]):
+        out[i + k] = x[k]
+
+
+@njit(cache=True)
+def add(out, i, x):
+    """out[i:i + len(x)] += x, as a loop (see the note above)."""
+    for k in range(x.shape[0]):
+        out[i + k] = out[i + k] + x[k]
+
+
+@njit(cache=True)
+def put2(out, i, j, x):
+    """out[i:i + rows, j:j + columns] = x (x 2-D), as a loop (see the note above)."""
+    for r in range(x.shape[0]):
+        for c in range(x.shape[1]):
+            out[i + r, j + c] = x[r, c]
+
+
+@njit(cache=True)
+def add2(out, i, j, x):
+    """out[i:i + rows, j:j + columns] += x (x 2-D), as a loop (see the note above)."""
+    for r in range(x.shape[0]):
+        for c in range(x.shape[1]):
+            out[i + r, j + c] = out[i + r, j + c] + x[r, c]
+
+
+@njit(cache=True)
+def put_col(out, i, j, x):
+    """out[i:i + len(x), j] = x: x into column j from row i, as a loop (see the note above)."""
+    for k in range(x.shape[0]):
+        out[i + k, j] = x[k]
+
+
+@njit(cache=True)
+def add_col(out, i, j, x):
+    """out[i:i + len(x), j] += x, as a loop (see the note above)."""
+    for k in range(x.shape[0]):
+        out[i + k, j] = out[i + k, j] + x[k]

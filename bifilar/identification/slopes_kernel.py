@@ -27,7 +27,7 @@ import numba as nb
 import numpy as np
 
 from bifilar.rig import pose_kernel
-from bifilar.smallmat import inverse, mm, mv
+from bifilar.smallmat import inverse, mm, mv, put, put2
 
 _SINGULAR = 1e-10  # smallest / largest singular value of the equilibrium Jacobian treated as singular
 _CHORD_STEPS = 2
@@ -43,8 +43,8 @@ def unpack(x, n_wires):
     j = 0
     for i in range(n_wires):
         lengths[i] = x[j]
-        anchors[i] = x[j + 1 : j + 4]
-        attach[i] = x[j + 4 : j + 7]
+        put(anchors[i], 0, x[j + 1 : j + 4])
+        put(attach[i], 0, x[j + 4 : j + 7])
         j += 7
     mass = x[j]
     arms = attach - x[j + 1 : j + 4]
@@ -79,8 +79,8 @@ def mass_matrix(rot, inertia, mass, air_body, air):
             m6[3 + r, 3 + c] = acc
     if air:
         rot6 = np.zeros((6, 6))
-        rot6[:3, :3] = rot
-        rot6[3:, 3:] = rot
+        put2(rot6, 0, 0, rot)
+        put2(rot6, 3, 3, rot)
         m6 += mm(mm(rot6, air_body), rot6.T.copy())
     return m6
 

@@ -25,6 +25,7 @@ from bifilar.motion.nwire_kernel import STATE_SIZE, quat_matrix, state_rate
 from bifilar.smallmat import cross as _cross
 from bifilar.smallmat import mm as _mm
 from bifilar.smallmat import mv as _mv
+from bifilar.smallmat import add, add2, put, put2
 
 
 @njit(cache=True)
@@ -45,7 +46,7 @@ def dynamics(y, arms, anchors, lengths, springs, inertia_body, mass, gravity, ai
     iw = _mm(_mm(rot, inertia_body), rot.T.copy())
     f = np.zeros(6)
     f[2] = -mass * gravity
-    f[3:] = -_cross(om, _mv(iw, om))
+    put(f, 3, -_cross(om, _mv(iw, om)))
     tension = np.empty(n)
     stretch = np.empty(n)
     for i in range(n):
@@ -55,19 +56,19 @@ def dynamics(y, arms, anchors, lengths, springs, inertia_body, mass, gravity, ai
         stretch[i] = rho - lengths[i]
         tension[i] = springs[i] * stretch[i] if stretch[i] > 0.0 else 0.0
         pull = tension[i] * d / rho
-        f[:3] += pull
-        f[3:] += _cross(s, pull)
+        add(f, 0, pull)
+        add(f, 3, _cross(s, pull))
     if air[AIR_FLAG] != 0.0:
         maw, bias, drag = air_terms(rot, v, om, air)
         m6 = maw.copy()
         for k in range(3):
             m6[k, k] += mass
-        m6[3:, 3:] += iw
+        add2(m6, 3, 3, iw)
         acc = np.linalg.solve(m6, f + drag - bias)
     else:
         acc = np.empty(6)
-        acc[:3] = f[:3] / mass
-        acc[3:] = np.linalg.solve(iw, f[3:])
+        put(acc, 0, f[:3] / mass)
+        put(acc, 3, np.linalg.solve(iw, f[3:]))
     return acc, tension, stretch
 
 
@@ -89,8 +90,10 @@ def observe(Y, arms, anchors, lengths, springs, inertia_body, mass, gravity, air
     for k in range(n_s):
         y = Y[k]
         rot = quat_matrix(y[3:7])
-        frames[k] = rot
-        _, ten[k], stretch[k] = dynamics(y, arms, anchors, lengths, springs, inertia_body, mass, gravity, air)
+        put2(frames[k], 0, 0, rot)
+        _, ten_k, stretch_k = dynamics(y, arms, anchors, lengths, springs, inertia_body, mass, gravity, air)
+        put(ten[k], 0, ten_k)
+        put(stretch[k], 0, stretch_k)
         om, v = y[10:13], y[7:10]
         iw = _mm(_mm(rot, inertia_body), rot.T.copy())
         energy[k] = 0.5 * mass * _dot(v, v) + 0.5 * _dot(om, _mv(iw, om)) + mass * gravity * y[2]

@@ -42,6 +42,7 @@ from bifilar.smallmat import cross as _cross
 from bifilar.smallmat import mm as _mm
 from bifilar.smallmat import mv as _mv
 from bifilar.smallmat import solve as _solve
+from bifilar.smallmat import add, add2, add_col, put, put2, put_col
 
 POLAR, TILT = 0, 1
 
@@ -111,7 +112,7 @@ def kinematics(th, dth, p, chart):
     s4, c4, s5, c5 = np.sin(th[3]), np.cos(th[3]), np.sin(th[4]), np.cos(th[4])
     # Angular velocity omega = th1' n~3 - th4' n3 + th5' (c4 n1 - s4 n2): the basis Q of (5.1.8).
     G = np.zeros((3, 5))
-    G[:, 0] = n3t
+    put_col(G, 0, 0, n3t)
     G[2, 3] = -1.0
     G[0, 4] = c4
     G[1, 4] = -s4
@@ -123,19 +124,19 @@ def kinematics(th, dth, p, chart):
     wbias = dth[0] * (n3t_4 * dth[3] + n3t_5 * dth[4]) + dth[4] * dth[3] * e5_4
     # V = C + W: velocity of C along the wire plus omega x r, column by column.
     V = np.zeros((3, 5))
-    V[:, 1] = l * u2
-    V[:, 2] = l * u3
+    put_col(V, 0, 1, l * u2)
+    put_col(V, 0, 2, l * u3)
     for i in range(5):
-        V[:, i] += _cross(G[:, i], r)
+        add_col(V, 0, i, _cross(G[:, i], r))
     ubias = u22 * dth[1] ** 2 + 2.0 * u23 * dth[1] * dth[2] + u33 * dth[2] ** 2
     vbias = l * ubias + _cross(wbias, r) + _cross(omega, _cross(omega, r))
     # Loop closure: d = AD = AB + l u + CD, CD = -b' n~3.
     d = p[8:11] + l * u - bp * n3t
     J = np.zeros((3, 5))
-    J[:, 1] = l * u2
-    J[:, 2] = l * u3
-    J[:, 3] = -bp * n3t_4
-    J[:, 4] = -bp * n3t_5
+    put_col(J, 0, 1, l * u2)
+    put_col(J, 0, 2, l * u3)
+    put_col(J, 0, 3, -bp * n3t_4)
+    put_col(J, 0, 4, -bp * n3t_5)
     # d2(n~3)/dt2 at zero theta'': n~3 is body-fixed, so it is wbias x n~3 + omega x (omega x n~3).
     n3t_bias = _cross(wbias, n3t) + _cross(omega, _cross(omega, n3t))
     dbias = l * ubias - bp * n3t_bias
@@ -155,22 +156,22 @@ def air_terms(R, v, omega, p):
     -(M_A,w [acc; alpha] + b) plus the drag) and the drag wrench (F; G about R*, world)."""
     ma = p[24:60].copy().reshape((6, 6))
     rot6 = np.zeros((6, 6))
-    rot6[:3, :3] = R
-    rot6[3:, 3:] = R
+    put2(rot6, 0, 0, R)
+    put2(rot6, 3, 3, R)
     maw = _mm(_mm(rot6, ma), rot6.T.copy())
     x = np.concatenate((v, omega))
     h = _mv(maw, x)  # [P; L]
     spin = np.zeros(6)
-    spin[:3] = _cross(omega, v)
+    put(spin, 0, _cross(omega, v))
     b = -_mv(maw, spin)  # d(M_A,w)/dt x = Omega M_A,w x - M_A,w Omega x
-    b[:3] += _cross(omega, h[:3])
-    b[3:] += _cross(omega, h[3:]) + _cross(v, h[:3])
+    add(b, 0, _cross(omega, h[:3]))
+    add(b, 3, _cross(omega, h[3:]) + _cross(v, h[:3]))
     axes = _mm(R, p[63:72].copy().reshape((3, 3)))
     c = _mv(R, p[60:63].copy())
     f_e, g_e = drag_wrench(_mv(axes.T.copy(), v + _cross(omega, c)), _mv(axes.T.copy(), omega), p[72:80])
     drag = np.empty(6)
-    drag[:3] = _mv(axes, f_e)
-    drag[3:] = _mv(axes, g_e) + _cross(c, drag[:3])
+    put(drag, 0, _mv(axes, f_e))
+    put(drag, 3, _mv(axes, g_e) + _cross(c, drag[:3]))
     return maw, b, drag
 
 
@@ -194,17 +195,17 @@ def eom(th, dth, p, chart):
     M5 = np.empty((5, 5))
     N5 = np.empty(5)
     VnT, GnT = Vn.T.copy(), Gn.T.copy()
-    M5[:4, :] = m * _mm(VnT, V) + _mm(GnT, _mm(Iw, G))
+    put2(M5, 0, 0, m * _mm(VnT, V) + _mm(GnT, _mm(Iw, G)))
     weight = np.array([0.0, 0.0, m * g])
     Iw_omega = _mv(Iw, omega)
-    N5[:4] = -_mv(VnT, m * vbias + weight) - _mv(GnT, _mv(Iw, wbias) + _cross(omega, Iw_omega))
+    put(N5, 0, -_mv(VnT, m * vbias + weight) - _mv(GnT, _mv(Iw, wbias) + _cross(omega, Iw_omega)))
     if p[P_AIR] != 0.0:
         maw, b, drag = air_terms(R, _mv(V, dth), omega, p)
         P6 = np.vstack((V, G))
         Pn6T = np.vstack((Vn, Gn)).T.copy()
-        M5[:4, :] += _mm(Pn6T, _mm(maw, P6))
-        N5[:4] += _mv(Pn6T, drag - b - _mv(maw, np.concatenate((vbias, wbias))))
-    M5[4, :] = beta
+        add2(M5, 0, 0, _mm(Pn6T, _mm(maw, P6)))
+        add(N5, 0, _mv(Pn6T, drag - b - _mv(maw, np.concatenate((vbias, wbias)))))
+    put(M5[4], 0, beta)
     ddot = _mv(J, dth)
     N5[4] = -2.0 * (ddot @ ddot + d @ dbias)
     return M5, N5
@@ -215,8 +216,8 @@ def rhs(y, p, chart):
     """First-order form y = (theta, theta') -> y', theta'' from M5 theta'' = N5 (:func:`eom`)."""
     M5, N5 = eom(y[:5], y[5:], p, chart)
     out = np.empty(10)
-    out[:5] = y[5:]
-    out[5:] = _solve(M5, N5)
+    put(out, 0, y[5:])
+    put(out, 5, _solve(M5, N5))
     return out
 
 
@@ -252,17 +253,18 @@ def loads(th, dth, p, chart):
     arm_c = -r  # R* -> C
     arm_d = -r - bp * R[:, 2]  # R* -> D = R* -> C + CD
     A = np.empty((6, 2))
-    A[:3, 0] = e1
-    A[:3, 1] = e2
-    A[3:, 0] = _cross(arm_c, e1) / bp
-    A[3:, 1] = _cross(arm_d, e2) / bp
+    put_col(A, 0, 0, e1)
+    put_col(A, 0, 1, e2)
+    put_col(A, 3, 0, _cross(arm_c, e1) / bp)
+    put_col(A, 3, 1, _cross(arm_d, e2) / bp)
     rhs_ = np.empty(6)
-    rhs_[:3] = m * acc + np.array([0.0, 0.0, m * g])
-    rhs_[3:] = _mv(Iw, alpha) + _cross(omega, _mv(Iw, omega))
+    put(rhs_, 0, m * acc + np.array([0.0, 0.0, m * g]))
+    put(rhs_, 3, _mv(Iw, alpha) + _cross(omega, _mv(Iw, omega)))
     if p[P_AIR] != 0.0:  # the wires carry what the air does not: minus the fluid's wrench
         maw, b, drag = air_terms(R, _mv(V, dth), omega, p)
         rhs_ += _mv(maw, np.concatenate((acc, alpha))) + b - drag
-    rhs_[3:] /= bp
+    for k in range(3, 6):
+        rhs_[k] /= bp
     At = A.T.copy()
     tension = _solve(_mm(At, A), _mv(At, rhs_))
     res = _mv(A, tension) - rhs_
@@ -287,11 +289,11 @@ def observe(Y, p, chart):
         th, dth = Y[i, :5].copy(), Y[i, 5:].copy()
         u, R, r, V, G, vbias, wbias, d, J, dbias = kinematics(th, dth, p, chart)
         c, _ = pose(th, p, chart)
-        com[i] = c
-        frames[i] = R
-        vel[i] = _mv(V, dth)
-        omg[i] = _mv(G, dth)
-        tension[i] = loads(th, dth, p, chart)[0]
+        put(com[i], 0, c)
+        put2(frames[i], 0, 0, R)
+        put(vel[i], 0, _mv(V, dth))
+        put(omg[i], 0, _mv(G, dth))
+        put(tension[i], 0, loads(th, dth, p, chart)[0])
         err2[i] = np.sqrt(d @ d) - p[P_LP]
         Iw = inertia_world(R, p)
         energy[i] = 0.5 * m * (vel[i] @ vel[i]) + 0.5 * (omg[i] @ _mv(Iw, omg[i])) + m * g * c[2]

@@ -23,6 +23,7 @@ from numba import njit
 from bifilar.motion.kane_kernel import P_AIR as AIR_FLAG
 from bifilar.motion.kane_kernel import air_terms
 from bifilar.smallmat import cross as _cross
+from bifilar.smallmat import add2, put, put2, put_col
 
 STATE_SIZE = 13
 
@@ -113,12 +114,12 @@ def _system(y, arms, anchors, inertia_body, mass, gravity, air):
         u = d / rho[i]
         w = v + _cross(om, s)
         uw = u @ w
-        jac[i, :3] = -u
-        jac[i, 3:] = _cross(u, s)
+        put(jac[i], 0, -u)
+        put(jac[i], 3, _cross(u, s))
         b[i] = u @ _cross(om, _cross(om, s)) - (w @ w - uw * uw) / rho[i]
     f = np.zeros(6)
     f[2] = -mass * gravity
-    f[3:] = -_cross(om, iw @ om)
+    put(f, 3, -_cross(om, iw @ om))
     minv_f = np.empty(6)
     minv_jt = np.empty((6, n))
     if air[AIR_FLAG] != 0.0:
@@ -126,18 +127,18 @@ def _system(y, arms, anchors, inertia_body, mass, gravity, air):
         m6 = maw.copy()
         for k in range(3):
             m6[k, k] += mass
-        m6[3:, 3:] += iw
+        add2(m6, 3, 3, iw)
         f += drag - bias
         m6_inv = np.linalg.inv(m6)
-        minv_f[:] = m6_inv @ f
-        minv_jt[:, :] = m6_inv @ jac.T
+        put(minv_f, 0, m6_inv @ f)
+        put2(minv_jt, 0, 0, m6_inv @ jac.T)
     else:
         # M^-1 applied to f and to each row of J (as columns of M^-1 J^T).
-        minv_f[:3] = f[:3] / mass
-        minv_f[3:] = iw_inv @ f[3:]
+        put(minv_f, 0, f[:3] / mass)
+        put(minv_f, 3, iw_inv @ f[3:])
         for i in range(n):
-            minv_jt[:3, i] = jac[i, :3] / mass
-            minv_jt[3:, i] = iw_inv @ jac[i, 3:]
+            put_col(minv_jt, 0, i, jac[i, :3] / mass)
+            put_col(minv_jt, 3, i, iw_inv @ jac[i, 3:])
     return minv_f, minv_jt, jac, b, rho
 
 
@@ -151,8 +152,8 @@ def dynamics_jacobian(y, arms, anchors):
         s = rot @ arms[i]
         d = anchors[i] - y[0:3] - s
         u = d / np.sqrt(d @ d)
-        jac[i, :3] = -u
-        jac[i, 3:] = _cross(u, s)
+        put(jac[i], 0, -u)
+        put(jac[i], 3, _cross(u, s))
     return jac
 
 
@@ -168,12 +169,12 @@ def state_rate(y, acc):
     (world) are ``acc``: velocities, q' = (1/2) (0, omega) * q (world omega), accelerations."""
     q, om = y[3:7], y[10:13]
     dy = np.empty(STATE_SIZE)
-    dy[0:3] = y[7:10]
+    put(dy, 0, y[7:10])
     dy[3] = -0.5 * (om[0] * q[1] + om[1] * q[2] + om[2] * q[3])
     dy[4] = 0.5 * (om[0] * q[0] + om[1] * q[3] - om[2] * q[2])
     dy[5] = 0.5 * (-om[0] * q[3] + om[1] * q[0] + om[2] * q[1])
     dy[6] = 0.5 * (om[0] * q[2] - om[1] * q[1] + om[2] * q[0])
-    dy[7:13] = acc
+    put(dy, 7, acc)
     return dy
 
 
@@ -188,8 +189,8 @@ def observe(Y, arms, anchors, inertia_body, mass, gravity, air):
     for k in range(n_s):
         y = Y[k]
         rot = quat_matrix(y[3:7])
-        frames[k] = rot
-        ten[k] = dynamics(y, arms, anchors, inertia_body, mass, gravity, air)[1]
+        put2(frames[k], 0, 0, rot)
+        put(ten[k], 0, dynamics(y, arms, anchors, inertia_body, mass, gravity, air)[1])
         om, v = y[10:13], y[7:10]
         iw = rot @ inertia_body @ rot.T
         energy[k] = 0.5 * mass * (v @ v) + 0.5 * (om @ (iw @ om)) + mass * gravity * y[2]

@@ -26,7 +26,7 @@ from __future__ import annotations
 import numba as nb
 import numpy as np
 
-from bifilar.smallmat import cross, mm
+from bifilar.smallmat import cross, mm, put, put2, put_col
 
 
 @nb.njit(cache=True)
@@ -176,8 +176,8 @@ def equilibrium_residual(com, rot, tensions, arms, anchors, lengths, weight, sca
                 jac[3 + r, 3 + c] += t * turn[r, c] / scale
             jac[r, 6 + i] = u[i, r]
             jac[6 + i, r] = -u[i, r] / scale
-        jac[3:6, 6 + i] = cross(s[i], u[i]) / scale
-        jac[6 + i, 3:6] = cross(u[i], s[i]) / scale
+        put_col(jac, 3, 6 + i, cross(s[i], u[i]) / scale)
+        put(jac[6 + i], 3, cross(u[i], s[i]) / scale)
     return res, jac
 
 
@@ -231,18 +231,22 @@ def reduced_matrices(com, rot, tensions, arms, anchors, inertia_body, mass, scal
     n = arms.shape[0]
     s, u, rho = wire_geometry(com, rot, arms, anchors)
     jac = constraint_jacobian(s, u)
-    jac[:, 3:] /= scale
+    for r in range(jac.shape[0]):
+        for c in range(3, 6):
+            jac[r, c] /= scale
     _, sv, vt = np.linalg.svd(jac)
     rank = 0
     for k in range(sv.shape[0]):
         if sv[k] > null_tol * sv[0]:
             rank += 1
     z = np.ascontiguousarray(vt[rank:, :].T)
-    z[3:, :] /= scale
+    for r in range(3, 6):
+        for c in range(z.shape[1]):
+            z[r, c] /= scale
     m6 = np.zeros((6, 6))
     for k in range(3):
         m6[k, k] = mass
-    m6[3:, 3:] = mm(mm(rot, inertia_body), rot.T.copy())
+    put2(m6, 3, 3, mm(mm(rot, inertia_body), rot.T.copy()))
     k6 = np.zeros((6, 6))
     for i in range(n):
         k6 += tensions[i] * constraint_hessian(s, u, rho, i)

@@ -43,6 +43,7 @@ from scipy.integrate import solve_ivp
 from bifilar.jit import announce_compile
 from bifilar.smallmat import mm as _mm
 from bifilar.smallmat import mv as _mv
+from bifilar.smallmat import add2, put, put2, put_col
 
 
 @dataclass(frozen=True)
@@ -204,15 +205,15 @@ def _kinematics(q, qd, S, axes, coord, angle, body, nb):
         Erel = _frame_matrix(axes[f], angle[f] if k < 0 else q[k], S[f])
         Einv = _inverse(Erel)
         for j in range(n):
-            Om[j] = _mm(_mm(Einv, Om[j]), Erel)
-            Omd[j] = _mm(_mm(Einv, Omd[j]), Erel)
+            put2(Om[j], 0, 0, _mm(_mm(Einv, Om[j]), Erel))
+            put2(Omd[j], 0, 0, _mm(_mm(Einv, Omd[j]), Erel))
         if k >= 0:
             G = np.zeros((4, 4))
-            G[:3, :3] = _skew(axes[f])
-            Om[k] += G
+            put2(G, 0, 0, _skew(axes[f]))
+            add2(Om[k], 0, 0, G)
             Omega_rel = G * qd[k]
             for j in range(n):
-                Omd[j] += _mm(Om[j], Omega_rel) - _mm(Omega_rel, Om[j])
+                add2(Omd[j], 0, 0, _mm(Om[j], Omega_rel) - _mm(Omega_rel, Om[j]))
         E = _mm(E, Erel)
         i = body[f]
         if i < 0:
@@ -224,11 +225,13 @@ def _kinematics(q, qd, S, axes, coord, angle, body, nb):
         for j in range(n):
             u = np.ascontiguousarray(Om[j, :3, 3])  # column j of (R^i)^T xdot^i
             udot = np.ascontiguousarray(Omd[j, :3, 3])
-            B[6 * i : 6 * i + 3, j] = _mv(Ri, u)
-            B[6 * i + 3 : 6 * i + 6, j] = _unskew(Om[j, :3, :3])
-            Bdot[6 * i : 6 * i + 3, j] = _mv(Ri, _mv(W, u) + udot)
-            Bdot[6 * i + 3 : 6 * i + 6, j] = _unskew(Omd[j, :3, :3])
-        R[i], x[i], omega[i] = Ri, E[:3, 3], _unskew(W)
+            put_col(B, 6 * i, j, _mv(Ri, u))
+            put_col(B, 6 * i + 3, j, _unskew(Om[j, :3, :3]))
+            put_col(Bdot, 6 * i, j, _mv(Ri, _mv(W, u) + udot))
+            put_col(Bdot, 6 * i + 3, j, _unskew(Omd[j, :3, :3]))
+        put2(R[i], 0, 0, Ri)
+        put(x[i], 0, E[:3, 3])
+        put(omega[i], 0, _unskew(W))
     return R, x, omega, B, Bdot
 
 
@@ -236,8 +239,8 @@ def _kinematics(q, qd, S, axes, coord, angle, body, nb):
 def _frame_matrix(axis, angle, s):
     """The seed's relative frame matrix [[R_axis(angle), s], [0, 1]] (unit axis)."""
     E = np.eye(4)
-    E[:3, :3] = _rotation(axis, angle)
-    E[:3, 3] = s
+    put2(E, 0, 0, _rotation(axis, angle))
+    put_col(E, 0, 3, s)
     return E
 
 
@@ -253,8 +256,8 @@ def _inverse(E):
     """The seed's inverse frame matrix [[R^T, -R^T s], [0, 1]]."""
     out = np.eye(4)
     Rt = np.ascontiguousarray(E[:3, :3].T)
-    out[:3, :3] = Rt
-    out[:3, 3] = -_mv(Rt, np.ascontiguousarray(E[:3, 3]))
+    put2(out, 0, 0, Rt)
+    put_col(out, 0, 3, -_mv(Rt, np.ascontiguousarray(E[:3, 3])))
     return out
 
 

@@ -25,6 +25,7 @@ from bifilar.motion.modes import resolution  # the neutral and degenerate tests 
 from bifilar.rig import pose_kernel
 from bifilar.rig.statics import NEWTON_ITERATIONS, RESIDUAL  # the same Newton as rest_pose
 from bifilar.smallmat import mm, mv  # loops: numba's `@` compiles a BLAS path per operand layout
+from bifilar.smallmat import put
 
 OK, NO_NEWTON, SLACK, NO_MODES, UNSTABLE, NEUTRAL, DEGENERATE = range(7)
 
@@ -78,9 +79,9 @@ def peak_tension(com, rot, shapes, omegas, springs, base, arms, anchors, inertia
     y = np.zeros(NK.STATE_SIZE)
     peak = -np.inf
     for k in range(shapes.shape[0]):
-        y[:3] = com
-        y[3:7] = NK.matrix_quat(rot)
-        y[7:13] = omegas[k] * shapes[k]
+        put(y, 0, com)
+        put(y, 3, NK.matrix_quat(rot))
+        put(y, 7, omegas[k] * shapes[k])
         if springs.size:
             peak = max(peak, NK.compatible_tensions(y, arms, anchors, inertia, mass, gravity, air, springs, base).max())
             stretch = springs * np.abs(mv(NK.dynamics_jacobian(y, arms, anchors), shapes[k]))
@@ -88,8 +89,9 @@ def peak_tension(com, rot, shapes, omegas, springs, base, arms, anchors, inertia
             continue
         peak = max(peak, NK.dynamics(y, arms, anchors, inertia, mass, gravity, air)[1].max())
         for sign in (1.0, -1.0):
-            y[:3] = com + sign * shapes[k, :3]
-            y[3:7] = NK.matrix_quat(mm(pose_kernel.rotation_vector_matrix(sign * shapes[k, 3:]), rot))
-            y[7:13] = 0.0
+            put(y, 0, com + sign * shapes[k, :3])
+            put(y, 3, NK.matrix_quat(mm(pose_kernel.rotation_vector_matrix(sign * shapes[k, 3:]), rot)))
+            for j in range(7, 13):
+                y[j] = 0.0
             peak = max(peak, NK.dynamics(y, arms, anchors, inertia, mass, gravity, air)[1].max())
     return peak
