@@ -20,8 +20,8 @@ from bifilar import kernels
 from .registry import REGISTRY, Case, CaseContext, Metric
 
 # The compile time of every kernel the cases use, empty cache, 2 cores: each worker compiles its share
-# in ~31 s of CPU (python benchmarks/compile_cpu.py shares 2), and the first run took 65.2 s against
-# 32.7 s warm on a quiet machine (python benchmarks/first_run.py all); a busy machine takes longer.
+# in ~28 s of CPU (python benchmarks/compile_cpu.py shares 2), and the first run took 64.5 s against
+# 33.8 s warm on a quiet machine (python benchmarks/first_run.py all); a busy machine takes longer.
 COMPILE_SECONDS = "30-60"
 
 
