@@ -38,7 +38,7 @@ from bifilar.identification.records import phase_law
 from bifilar.identification.records import synthetic as Y
 from bifilar.identification.records.fit import fit_oscillation
 from bifilar.identification.records.law import AmplitudeLaw
-from bifilar.identification.records.phase_fit import EXCESS_TERMS
+from bifilar.identification.records.phase_fit import EXCESS_TERMS, law_induced
 from validate.cases.records import ROD
 
 ESTIMATORS = ("used", "white", "scaled", "hc", "nw2")
@@ -62,9 +62,7 @@ def _checking(model, fit, cyc):
 def estimates(jd, jp, r, j_envelope, cov_envelope, excess, cov_used) -> dict[str, float]:
     """omega0's law-induced variance less its priors' part (what the fit's statistical sigma holds
     beyond the whole fit's own) under each estimator of the phase scores' covariance."""
-    hessian = jd.T @ jd + jp.T @ jp
-    scale = 1.0 / np.sqrt(np.maximum(np.diag(hessian), 1e-300))
-    bread = scale[:, None] * np.linalg.pinv(scale[:, None] * hessian * scale[None, :]) * scale[None, :]
+    bread = phase_law.bread(jd, jp)
     n, k = jd.shape
     hat = float(np.trace(jd @ bread @ jd.T))
     cross = jd.T @ j_envelope
@@ -82,11 +80,7 @@ def estimates(jd, jp, r, j_envelope, cov_envelope, excess, cov_used) -> dict[str
             "scaled": white * max(1.0, float(r @ r) / max(n - k, 1)) + envelope,
             "hc": bread @ meat @ bread * dof + envelope, "nw2": bread @ hac @ bread * dof + envelope}
     law = list(range(2, 2 + len(EXCESS_TERMS))) if excess else []
-    out = {}
-    for name, cov in covs.items():
-        total = cov + prior
-        c = total[1, law]
-        out[name] = float(c @ np.linalg.pinv(total[np.ix_(law, law)]) @ c) - prior[1, 1] if law else float(cov[1, 1])
+    out = {name: law_induced(cov + prior, law) - prior[1, 1] if law else float(cov[1, 1]) for name, cov in covs.items()}
     out["chi2"] = float(r @ r) / max(n - hat, 1.0)
     return out
 

@@ -122,11 +122,16 @@ class PhaseFit:
         the priors'): Sigma_wL Sigma_LL^-1 Sigma_Lw of the whole covariance, the part a fit holding the
         law at its estimate does not see."""
         law = [i for i, n in enumerate(self.names) if n in EXCESS_TERMS or n in ("kappa", "q")]
-        if not law:
-            return 0.0
-        cov = self.cov_stat + self.cov_law
-        cross = cov[1, law]
-        return float(cross @ np.linalg.pinv(cov[np.ix_(law, law)]) @ cross)
+        return law_induced(self.cov_stat + self.cov_law, law)
+
+
+def law_induced(cov: np.ndarray, law: list[int]) -> float:
+    """Sigma_wL Sigma_LL^-1 Sigma_Lw of covariance ``cov`` (omega0 its row 1, ``law`` the law's rows):
+    the variance of omega0 that the law's parameters carry (0 without them)."""
+    if not law:
+        return 0.0
+    cross = cov[1, law]
+    return float(cross @ np.linalg.pinv(cov[np.ix_(law, law)]) @ cross)
 
 
 def _carried(tt, grid, cum, g0, g1):

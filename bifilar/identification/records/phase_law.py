@@ -346,12 +346,7 @@ def _covariance(jd, jp, r, j_envelope, cov_envelope, excess: bool):
     two-step estimate's correction, Murphy and Topel: H^-1 (J^T J_A) V_A (J_A^T J) H^-1, J_A the phases'
     response to the envelope's coefficients); ``excess``: the law's excess terms are fitted (the first
     rows after phi and omega)."""
-    hessian = jd.T @ jd + jp.T @ jp
-    # equilibrated before the inverse: the columns differ by ~1e3 in scale (phase, omega0 times the
-    # record's span, the excess times A^2), and at a nearly constant swing the direction only the
-    # priors fix has ~1e-10 of the largest curvature, which pinv's cut would otherwise round away
-    scale = 1.0 / np.sqrt(np.maximum(np.diag(hessian), 1e-300))
-    bread_inv = scale[:, None] * np.linalg.pinv(scale[:, None] * hessian * scale[None, :]) * scale[None, :]
+    bread_inv = bread(jd, jp)
     stat_white, stat_sand, _ = white_and_blocks(jd, r, bread_inv)
     cross = jd.T @ j_envelope
     envelope = bread_inv @ cross @ cov_envelope @ cross.T @ bread_inv
@@ -361,6 +356,16 @@ def _covariance(jd, jp, r, j_envelope, cov_envelope, excess: bool):
     # come first): records of one rig share that error, while a proportional record's scale is its own
     law_rows = len(EXCESS_TERMS) if excess else 0
     return cov_stat, cov_law, (bread_inv @ jp.T)[1, :law_rows]
+
+
+def bread(jd, jp) -> np.ndarray:
+    """(J^T J + P^T P)^-1 of the phase fit (``jd`` its weighted phases' Jacobian, ``jp`` its priors'),
+    equilibrated before the inverse: the columns differ by ~1e3 in scale (phase, omega0 times the
+    record's span, the excess times A^2), and at a nearly constant swing the direction only the priors
+    fix has ~1e-10 of the largest curvature, which pinv's cut would otherwise round away."""
+    hessian = jd.T @ jd + jp.T @ jp
+    scale = 1.0 / np.sqrt(np.maximum(np.diag(hessian), 1e-300))
+    return scale[:, None] * np.linalg.pinv(scale[:, None] * hessian * scale[None, :]) * scale[None, :]
 
 
 class _Envelope:
