@@ -49,8 +49,9 @@ COMPONENTS = ("I_xx", "I_yy", "I_zz", "I_xy", "I_yz", "I_xz")
 _PAIRS = ((0, 0), (1, 1), (2, 2), (0, 1), (1, 2), (0, 2))
 _RANK_RTOL = 1e-8  # singular values of the relative Jacobian below this fraction are undetermined
 _TOL = 1e-11  # relative step at convergence: eigh rounding moves a small object on a heavy fixture ~4e-14
-# ... or, with the periods' sigmas given, a last step that moves the tensor by less than this many of its
-# standard deviations (its chi^2 decrement below the square): past it the steps are the periods' rounding.
+# from exact periods; from noisy ones its steps stall higher (below). So, with the periods' sigmas given, a
+# last step that moves the tensor by less than this many of its standard deviations (its chi^2 decrement
+# below the square) has converged too: past it the steps are the periods' rounding.
 # A 0.25 kg object on the 2 kg trifilar disc (validate's tensor-tare) converged in two steps to a relative
 # step of 4e-10 and then stalled at 4e-11..2e-10, each step lowering chi^2 by 7e-14..1.4e-12 (1e-6 of a
 # sigma), in 0-4 of the case's 200 fits as rounding moved its periods by 1e-13 (tests/test_tensor.py)
