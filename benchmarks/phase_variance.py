@@ -4,9 +4,9 @@ the scatter of T0 against the statistical sigma the fit states and against the l
 phase fit's covariance (:func:`bifilar.identification.records.phase_law._covariance`) as each candidate
 estimator of the phase scores' covariance would make it (1 for an honest sigma; below 1: too wide):
 
-    used   the estimator the fit uses: the larger of the block sandwich and the white covariance scaled
-           by chi^2 per degree of freedom, plus the envelope's part (before the jackknife and the law's
-           doubts, which ``stated`` adds)
+    used   the estimator the fit uses (stop 49: the long-run covariance, :func:`.spread.long_run`, at
+           least the white one) plus the envelope's part (before the jackknife, the envelope degree's
+           doubt and the law's doubts, which ``stated`` adds)
     white  the white covariance unscaled (the cycles' own phase variances taken as they are)
     scaled the white covariance scaled by chi^2 per degree of freedom
     hc     the heteroscedastic sandwich (scores summed per cycle), dof from the hat matrix's trace
@@ -48,8 +48,8 @@ _covariance = phase_law._covariance
 _check_law = phase_law.Model.check_law
 
 
-def _recording(jd, jp, r, j_envelope, cov_envelope, excess):
-    out = _covariance(jd, jp, r, j_envelope, cov_envelope, excess)
+def _recording(jd, jp, r, j_envelope, cov_envelope, excess, bread_inv):
+    out = _covariance(jd, jp, r, j_envelope, cov_envelope, excess, bread_inv)
     _calls.append((jd, jp, r, j_envelope, cov_envelope, excess, out[0]))
     return out
 

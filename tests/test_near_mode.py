@@ -1,5 +1,5 @@
 """A mode beating in near the first one's frequency lifts the envelope (bifilar.identification.records.near): decaying envelopes do not.
-Fits of one rig whose learned laws disagree (a record's halves, trials) hold their T0 under the ideal law."""
+Fits of one rig whose learned laws disagree (a record's halves, trials) carry the laws' spread through their T0."""
 
 import math
 from types import SimpleNamespace
@@ -52,14 +52,31 @@ def test_fits_whose_laws_agree_keep_their_own_variances():
     assert np.allclose(_own_variances(fits), 1e-8, rtol=1e-12)
 
 
-def test_fits_whose_laws_disagree_hold_the_ideal_law_s_periods():
+def test_fits_whose_laws_disagree_carry_their_spread_through_their_periods():
     # a sway beating in, its phase and size new in each fit, makes each learn its own law: ds 0.002 to
     # 0.030 +- 0.005 (benchmarks/near_mode.py's misses learned 0.007-0.024 +- 0.005-0.008; chi^2 27 on 5
-    # dof, past the 99 % quantile 15.1): each fit's T0 under the ideal law enters its variance
+    # dof, past the 99 % quantile 15.1). With equal sigmas the between-fits variance that brings chi^2 to
+    # its 5 dof is in closed form, the excesses' sample variance less their own (0.0106^2), and each
+    # fit's T0 carries it at its own response to the excess (gap / ds = 0.09 s per unit here)
     ds = np.array([0.002, 0.030, 0.016, 0.024, 0.006, 0.028])
     gaps = 0.09 * ds  # the excess's effect on T0 at 0.3 rad: ds A^2 (relative, T0 ~ 1 s)
     fits = [_fit(d, 0.005, g) for d, g in zip(ds, gaps)]
-    assert np.allclose(_own_variances(fits), 1e-8 + gaps**2, rtol=1e-12)
+    tau2 = ds.var(ddof=1) - 0.005**2
+    assert np.allclose(_own_variances(fits), 1e-8 + 0.09**2 * tau2, rtol=1e-9)
+
+
+def test_the_between_fits_variance_brings_chi2_to_its_degrees_of_freedom():
+    # unequal sigmas: no closed form; the excesses' chi^2 about their weighted mean, each variance
+    # widened by what _own_variances found (over the slopes' squares), is their 3 degrees of freedom
+    ds = np.array([0.01, 0.05, -0.02, 0.03])
+    sd = np.array([0.004, 0.008, 0.006, 0.01])
+    slopes = np.array([0.05, 0.08, 0.12, 0.02])
+    fits = [_fit(d, s, k * d) for d, s, k in zip(ds, sd, slopes)]
+    tau2 = (_own_variances(fits) - 1e-8) / slopes**2
+    assert np.allclose(tau2, tau2[0], rtol=1e-9)  # one variance of the law, each T0 at its own slope
+    w = 1.0 / (sd**2 + tau2[0])
+    chi = float(np.sum(w * (ds - np.sum(w * ds) / np.sum(w)) ** 2))
+    assert chi == pytest.approx(3.0, rel=1e-6)  # brentq stops within 2e-12 of tau^2 = 8.4e-4
 
 
 @pytest.mark.slow

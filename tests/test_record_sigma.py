@@ -1,9 +1,11 @@
-"""The record fit's statistical sigma checked by its jackknife (bifilar.identification.records.phase_law,
-Model.jackknife): tracking noise correlated over a fraction of a cycle moves a cycle's phase,
-amplitude and waveform together, which the fit's covariance does not model. On such records the
-jackknife over 20 groups of cycles is larger than the covariance at 95 % and sets the sigma; on short
-clean records it is not, and the covariance's efficiency is kept. Coverage over many records with
-every real trait is the slow case ``identify-record-coverage``."""
+"""The record fit's statistical sigma on records whose noise its covariance does not model
+(bifilar.identification.records.phase_law, fit): tracking noise correlated over a fraction of a cycle
+leaves Akaike's criterion unsure of the envelope's degree, whose choice moves T0 by about its sigma
+(Model.envelope_doubt carries it); a delete-a-group jackknife, taken over its leverage, checks the rest;
+on short clean records neither adds anything and the covariance's efficiency is kept. Coverage over many
+records with every real trait is the slow case ``identify-record-coverage``."""
+
+import math
 
 import numpy as np
 import pytest
@@ -16,24 +18,43 @@ from bifilar.motion import lagrange as L
 
 ROD = L.TorsionRig.parallel(0.5, 0.0016, 0.8, 0.196)
 LAW = AmplitudeLaw.torsion(ROD)
+# 100 cycles from 0.8 rad with AR(1) noise of 6.6 mrad over 0.12 s (a video tracker's), a law 25 %
+# stronger than the ideal
+VIDEO = Y.Traits(amplitude=0.8, cycles=100.0, white=0.0035, coloured=0.0066, colour_time=0.12, zeta=1.2e-3,
+                 excess=0.25, shape=0.1)
 
 
 @pytest.mark.slow
-def test_the_jackknife_widens_a_covariance_that_coloured_noise_leaves_short(monkeypatch):
-    # 100 cycles from 0.8 rad with AR(1) noise of 6.6 mrad over 0.12 s (a video tracker's), a law 25 %
-    # stronger than the ideal: over 16 such records T0 scattered 1.9x the covariance's sigma
-    traits = Y.Traits(amplitude=0.8, cycles=100.0, white=0.0035, coloured=0.0066, colour_time=0.12,
-                      zeta=1.2e-3, excess=0.25, shape=0.1)
-    rec = Y.record(ROD, np.random.default_rng(0), traits)
+def test_the_envelope_degree_s_doubt_widens_a_covariance_that_coloured_noise_leaves_short(monkeypatch):
+    # seed 0: Akaike's weights spread over degrees 2-8 (0.04-0.27 each), whose phase fits put T0 up to
+    # 9.6e-4 s from the chosen degree's; without that doubt the truth was 2.2 sigma out
+    rec = Y.record(ROD, np.random.default_rng(0), VIDEO)
     fit = F.fit_oscillation(rec.t, rec.y, "angle", LAW)
-    monkeypatch.setattr(P, "JACKKNIFE_GROUPS", 0)
+    monkeypatch.setattr(P.Model, "envelope_doubt", lambda self, phase, cyc: 0.0)
     alone = F.fit_oscillation(rec.t, rec.y, "angle", LAW)
-    assert fit.jackknife == 20 and alone.jackknife == 0
-    assert fit.period == alone.period  # the jackknife changes the sigma, never T0
-    # the statistical sigmas: the total also holds the law's doubts, which the jackknife leaves alone
-    assert fit.period_std_statistical / alone.period_std_statistical > 1.5  # measured 2.04
+    assert fit.period == alone.period  # the doubt changes the sigma, never T0
+    assert fit.period_std_statistical / alone.period_std_statistical > 1.4  # measured 1.72
     assert (abs(fit.period - rec.period) / fit.period_std < 1.96
-            < abs(alone.period - rec.period) / alone.period_std_statistical)
+            < abs(alone.period - rec.period) / alone.period_std)  # measured 1.38 and 2.22
+
+
+@pytest.mark.slow
+def test_video_records_with_coloured_noise_state_their_scatter():
+    # 32 such records (seeds 0-31): the statistical sigma is the same trait for each, so its rms against
+    # the scatter of T0 about the truth is the sigma's honesty, within the scatter's own 3-sigma error
+    # for 32 draws (1 +- 3 / sqrt(64)); measured 0.92, and 31 in their 95 % intervals. The jackknife over groups of cycles, reselecting
+    # the envelope's degree in every refit, had set 69 % of these sigmas at 1.8x the scatter, and still
+    # left 1 in 16 of them outside 95 % intervals
+    errors, sigmas, inside = [], [], 0
+    for seed in range(32):
+        rec = Y.record(ROD, np.random.default_rng(seed), VIDEO)
+        fit = F.fit_oscillation(rec.t, rec.y, "angle", LAW)
+        errors.append(fit.period - rec.period)
+        sigmas.append(fit.period_std_statistical)
+        inside += abs(fit.period - rec.period) < 1.96 * fit.period_std
+    ratio = math.sqrt(float(np.mean(np.square(sigmas))) / float(np.mean(np.square(errors))))
+    assert 1.0 - 3.0 / 8.0 < ratio < 1.0 + 3.0 / 8.0
+    assert inside >= 27  # binomial 99 % lower bound of 32 draws at 95 %
 
 
 @pytest.mark.parametrize("seed", [0, 1])

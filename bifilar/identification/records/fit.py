@@ -29,18 +29,21 @@ and assembles the result; each step is a module of its own.
    the ideal law, E = 1 + ds A^2 + dq A^4 + d6 A^6 the real rig's excess with Gaussian priors, D the
    damping's shift of the frequency (:mod:`.damping`). Weighted least squares gives omega0 = 2 pi / T0,
    the zero-amplitude period, and the excess.
-5. Uncertainty (:mod:`.spread`): the sandwich covariance with the phase residuals' scores summed over
-   blocks of :data:`.spread.BLOCK_TAUS` integrated autocorrelation times (tracker noise correlated over
-   many frames, a wandering offset, a left-over beat all make neighbouring cycles err together), never
-   below the white-noise covariance, plus what the envelope's own uncertainty adds (Murphy-Topel); the
-   prior rows add the law's doubt, reported apart (``period_std_law``), with the learned law's own
-   doubts (:meth:`.phase_law.Model.check_law`: its extrapolation to zero swing, a law no rig has or an
+5. Uncertainty (:mod:`.spread`): the long-run covariance of the phase residuals' scores (summed over
+   blocks of :data:`.spread.BLOCK_TAUS` integrated autocorrelation times where neighbouring cycles err
+   together: tracker noise correlated over many frames, a wandering offset; Newey-West over two
+   neighbours where they err in turn: a sway beating every few cycles), never below the white-noise
+   covariance, plus what the envelope's own uncertainty adds (Murphy-Topel) and what choosing its
+   degree adds (:meth:`.phase_law.Model.envelope_doubt`: Akaike's weights over the degrees, on video
+   records with noise correlated within a cycle a spread of T0 as large as the rest); the prior rows
+   add the law's doubt, reported apart (``period_std_law``), with the learned law's own doubts
+   (:meth:`.phase_law.Model.check_law`: its extrapolation to zero swing, a law no rig has or an
    envelope that rises again, a mode near the torsion's frequency beating in: :mod:`.near`). A
-   delete-a-group jackknife of the law's fit over 20 groups of cycles checks it
-   (:meth:`.phase_law.Model.jackknife`): where its variance is above the covariance's at 95 %, the
-   jackknife's (Student-t scaled) is the statistical variance.
-   Tracking noise correlated over a fraction of a cycle moves a cycle's phase, amplitude and waveform
-   together; on such video records the covariance alone covered the truth in 77 % of 95 % intervals.
+   delete-a-group jackknife of the law's fit over 20 groups of cycles, the envelope's degree held,
+   checks it (:meth:`.phase_law.Model.jackknife`): where its variance is above what it gives an honest
+   covariance at 95 % (the groups at the ends move omega0 more than their share:
+   :func:`.spread.jackknife_inflation`), the jackknife's over that ratio (Student-t scaled) is the
+   statistical variance.
 6. The whole record (:mod:`.whole`): every kept sample fitted at once with the law's shape held, for the
    efficiency of a plain damped-sine fit; its sandwich over cycles (scaled to the Student-t interval of
    its few blocks: :func:`.spread.few_blocks`) plus what the law's uncertainty adds is the statistical
@@ -113,13 +116,13 @@ class OscillationFit:
     proportional record is unknown).
 
     ``period`` is T0 = 2 pi / omega0; ``period_std`` its whole standard deviation, the root-sum-square
-    of ``period_std_statistical`` (the record's noise, block sandwich) and ``period_std_law`` (the
-    amplitude law's doubt, from the priors); ``period_std_white`` is the white-noise sigma, for
-    comparison. ``prior_gain`` maps the law's prior errors (in prior sigmas) to T0 (s per sigma):
-    records of one rig share that error (pooling). ``amplitude``: peak rotation in the first and last
-    cycle (None where the scale is unknown). ``cycle_*``: the measured cycles. ``jackknife``: the groups
-    of cycles of the jackknife that set the statistical sigma (0: the covariance held;
-    :meth:`.phase_law.Model.jackknife`). ``crb``: the Cramér-Rao bound's sigma of T0 (s) for the whole
+    of ``period_std_statistical`` (the record's noise: step 5's covariance and its checks) and
+    ``period_std_law`` (the amplitude law's doubt, from the priors); ``period_std_white`` is the
+    white-noise sigma, for comparison. ``prior_gain`` maps the law's prior errors (in prior sigmas) to
+    T0 (s per sigma): records of one rig share that error (pooling). ``amplitude``: peak rotation in the
+    first and last cycle (None where the scale is unknown). ``cycle_*``: the measured cycles.
+    ``jackknife``: the groups of cycles of the jackknife that set the statistical sigma (0: the
+    covariance held; :meth:`.phase_law.Model.jackknife`). ``crb``: the Cramér-Rao bound's sigma of T0 (s) for the whole
     fit's model with the law's parameters free under their priors (the record's part) and the noise its
     residual shows, judged ``crb_noise`` ('white'
     or 'coloured'; :mod:`.bound`): ``period_std_statistical / crb`` is how far the fit is from efficient.
@@ -250,10 +253,13 @@ def _result(rec: Samples, t: np.ndarray, cyc: Cycles, model: Model, phase: Phase
     std_all = to_period * math.sqrt(base + order)
     std_stat = math.sqrt(max(std_all**2 - std_law**2, to_period**2 * whole.variance))
     jack, groups = model.jackknife(phase, cyc)
-    if not (groups and jack > (std_stat / to_period) ** 2 * chi2.ppf(0.95, groups - 1) / (groups - 1)):
-        groups = 0  # the covariance holds (the jackknife, a variance of groups - 1 dof, is not above it at 95 %)
-    else:  # the covariance is short: the jackknife's, scaled to its Student-t interval as the blocks are
-        std_stat = max(std_stat, to_period * math.sqrt(jack * few_blocks(groups)))
+    ratio, dof = phase.jackknife_inflation
+    if not (groups and jack > (std_stat / to_period) ** 2 * ratio * chi2.ppf(0.95, dof) / dof):
+        groups = 0  # the covariance holds: the jackknife is not above what it gives an honest one at 95 %
+    else:  # the covariance is short: the jackknife's over its leverage, to its Student-t interval
+        std_stat = max(std_stat, to_period * math.sqrt(jack / ratio * few_blocks(groups)))
+    # what choosing the envelope's degree adds, which neither holds (the jackknife keeps the degree)
+    std_stat = math.hypot(std_stat, to_period * math.sqrt(model.envelope_doubt(phase, cyc)))
     std_white = to_period * math.sqrt(whole.variance_white)
     second = whole.second
     fitted = np.full(len(t), np.nan)

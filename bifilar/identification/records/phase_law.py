@@ -7,8 +7,9 @@ the waveform the record shows, ln A a Chebyshev series of the degree Akaike's cr
 :class:`_Envelope`), R the ideal law (:mod:`.law`), E = 1 + ds A^2 + dq A^4 + d6 A^6 the real rig's
 excess with Gaussian priors, D the damping's shift of the frequency
 (:mod:`.damping`). Weighted least squares gives omega0 = 2 pi / T0 and the excess; the covariance is
-the block sandwich of :mod:`.spread` plus what the envelope's own uncertainty adds, the priors' part
-apart, and a delete-a-group jackknife (:meth:`Model.jackknife`) checks it. A proportional record of a
+the long-run covariance of the cycles' scores (:mod:`.spread`) plus what the envelope's own
+uncertainty and the choice of its degree add (:meth:`Model.envelope_doubt`), the priors' part apart,
+and a delete-a-group jackknife (:meth:`Model.jackknife`) checks it. A proportional record of a
 compound pendulum has its scale q = kappa^2 from its own third harmonic (:func:`harmonic_scale`), a prior
 of the fit whose doubt is the law's part of T0's sigma. The learned law's own doubts
 (its extrapolation to zero swing, a law no rig has) are measured by refitting (:meth:`Model.check_law`).
@@ -30,7 +31,7 @@ from .law import AmplitudeLaw, Table
 from .near import envelope_rises
 from .phase_fit import EXCESS_TERMS, PhaseFit
 from .read import MIN_CYCLES
-from .spread import sandwich, white_and_blocks
+from .spread import jackknife_inflation, long_run, sandwich
 
 JACKKNIFE_GROUPS = 20  # groups of cycles of the jackknife (Model.jackknife): its variance has ~19 dof
 _PHASE_Z = 6.0  # a cycle's phase this many robust sigmas off the law: a slip (left out)
@@ -53,6 +54,7 @@ _ENVELOPE_F = 2.0
 # one: their difference enters T0's sigma (:meth:`Model.check_law`) and the fit says so (``Law.conflict``).
 # Learned alone from a gyro record with a mode 3 % from the torsion's, T0 came out 1.4 % off at 5 sigma.
 LAW_CONFLICT = 3.0
+_WEIGHT_FLOOR = 1e-3  # an envelope degree of less Akaike weight is not refitted (Model.envelope_doubt)
 _HELD = 1e-6  # a held excess's prior sd, relative to the prior's own: the data cannot move it
 # Gauss-Newton's last step: omega0's relative step (the excess terms' 100x that, relative to 1 + |d|). It
 # converges quadratically (omega0's steps 3e-2, 3e-6, 8e-9, 1e-12 on a 100-cycle record), so after a step
@@ -113,10 +115,11 @@ class Model:
         return previous
 
     def _solve(self, cyc: Cycles, good: np.ndarray, previous: PhaseFit | None, free: int = len(EXCESS_TERMS),
-               held: bool = False, parent: PhaseFit | None = None) -> PhaseFit:
+               held: bool = False, parent: PhaseFit | None = None, degree: int | None = None) -> PhaseFit:
         """One fit of the cycles ``good``, started from ``previous`` (:meth:`fit`), with the first ``free``
         excess terms free and the rest held at zero, or all ``held`` at the ideal law (:meth:`check_law`);
-        a jackknife refit (:meth:`jackknife`) takes its ``parent``'s scale, damping shift and start."""
+        a jackknife refit (:meth:`jackknife`) takes its ``parent``'s scale, damping shift and start;
+        ``degree``: the envelope's, where not Akaike's choice (:meth:`envelope_doubt`)."""
         centre, var = cyc.centre[good], cyc.phase_var[good]
         n = len(centre)
         # the cycles' peak amplitudes (signal units; of the angle for a rate) and their ln variances
@@ -125,7 +128,7 @@ class Model:
         peak_data = a1 * (1.0 + shape[0] * a1**2 + shape[1] * a1**4)
         log_sd = np.sqrt(cyc.amplitude_var[good]) / cyc.fundamental[good]
         grid = _phase_grid(centre)
-        envelope = _Envelope(centre, np.log(peak_data), log_sd)
+        envelope = _Envelope(centre, np.log(peak_data), log_sd, degree)
         b_grid = envelope.basis(grid)
         amp_grid = np.exp(b_grid @ envelope.beta)
         omega = float(np.median(cyc.omega[good])) if previous is None else previous.omega0
@@ -262,10 +265,17 @@ class Model:
             powers = np.array([(a_fit * a_fit) ** (j + 1) for j in range(len(EXCESS_TERMS))])
             sd = self.prior * abs(s) * np.sqrt(np.sum(powers**2, axis=0))
             conflict = float(np.max(np.abs(p[2:2 + len(EXCESS_TERMS)] @ powers) / np.maximum(sd, 1e-300)))
-        cov_stat, cov_law, prior_gain = _covariance(j_phase, jp, r_phase, j_envelope, envelope.cov, "ds" in names)
+        bread_inv = bread(j_phase, jp)
+        cov_stat, cov_law, prior_gain = _covariance(j_phase, jp, r_phase, j_envelope, envelope.cov, "ds" in names,
+                                                    bread_inv)
+        groups = min(JACKKNIFE_GROUPS, n)
+        inflation = (1.0, float(groups - 1))
+        if parent is None and groups >= 5:  # a jackknife refit is not itself jackknifed
+            inflation = jackknife_inflation(j_phase, bread_inv, groups)
         return PhaseFit(
             names=tuple(names), params=p, cov_stat=cov_stat, cov_law=cov_law,
-            prior_gain=prior_gain, residual=r_phase / weights, var=var, ideal=s if law_on else None,
+            prior_gain=prior_gain, jackknife_inflation=inflation, envelope_degree=envelope.degree,
+            envelope_weights=envelope.weights, residual=r_phase / weights, var=var, ideal=s if law_on else None,
             conflict=conflict, held=held, scale_known=self.kind != "proportional" or "kappa" in names or "q" in names,
             damping=damping, shift_curve=shift_curve, harmonic=harmonic, table=table, table_key=table_key,
             grid=grid, amplitude=amp_grid, peak=a_fit if law_on else None, rate=g_fit,
@@ -305,11 +315,11 @@ class Model:
     def jackknife(self, fit: PhaseFit, cyc: Cycles) -> tuple[float, int]:
         """(variance of omega0, groups): the delete-a-group jackknife of ``fit`` over up to
         :data:`JACKKNIFE_GROUPS` contiguous groups of the good cycles, each refitted whole (waveform,
-        envelope and phases). It sees every path by which a record's noise reaches omega0, those the
-        covariance models (the phases, the envelope) and those it does not (noise correlated within
-        a cycle, which moves phase, amplitude and waveform together; the law's shape misfit), which
-        on records with tracking noise correlated over a fraction of a cycle leaves the covariance
-        ~2x short (tests/test_record_sigma.py)."""
+        envelope and phases) with the envelope's degree held (the doubt of that choice is
+        :meth:`envelope_doubt`'s). It sees the paths by which a record's noise reaches omega0 that the
+        covariance does not model (the law's shape misfit, what moves a cycle's phase and amplitude
+        together); of an honest covariance it gives ``fit.jackknife_inflation``'s ratio (the groups at
+        the ends move omega0 more than their share), which :mod:`.fit` tests it against."""
         good = np.flatnonzero(cyc.good & np.isfinite(cyc.phase))
         groups = min(JACKKNIFE_GROUPS, len(good))
         if groups < 5:
@@ -322,9 +332,30 @@ class Model:
         for part in np.array_split(good, groups):
             keep = cyc.good & np.isfinite(cyc.phase)
             keep[part] = False
-            omegas.append(self._solve(cyc, keep, start, parent=fit).omega0)
+            omegas.append(self._solve(cyc, keep, start, parent=fit, degree=fit.envelope_degree).omega0)
         omegas = np.array(omegas)
         return float((groups - 1) / groups * np.sum((omegas - omegas.mean()) ** 2)), groups
+
+    def envelope_doubt(self, fit: PhaseFit, cyc: Cycles) -> float:
+        """The variance of omega0 (rad^2/s^2) that choosing the envelope's degree adds (Buckland, Burnham
+        and Augustin 1997): the cycles refitted at every degree of Akaike weight w_k above
+        :data:`_WEIGHT_FLOOR`, sum w_k (omega_k - sum w_j omega_j)^2. The law reads the swing off the
+        envelope, and where noise correlated within a cycle leaves Akaike's criterion unsure (weights of
+        0.04-0.27 over degrees 2-8 on one 100-cycle video record of 0.8 rad), the degrees' T0 differ by
+        up to ~1e-3 s, as much as the rest of the sigma: a spread the covariance, which holds the degree
+        chosen, does not see. On such records it left the phase fit's covariance 1.5x short of the
+        scatter, which the jackknife, reselecting the degree in every refit, took up in jumps (its sd
+        1.7x the scatter in rms)."""
+        w = fit.envelope_weights
+        kept = np.flatnonzero(w > _WEIGHT_FLOOR)
+        if len(kept) < 2:
+            return 0.0
+        good = cyc.good & np.isfinite(cyc.phase)
+        omegas = np.array([fit.omega0 if k == fit.envelope_degree else self._solve(cyc, good, fit, degree=int(k)).omega0
+                           for k in kept])
+        weights = w[kept] / w[kept].sum()
+        mean = float(weights @ omegas)
+        return float(weights @ (omegas - mean) ** 2)
 
 
 def unwrap(cyc: Cycles, good: np.ndarray) -> np.ndarray:
@@ -340,17 +371,18 @@ def unwrap(cyc: Cycles, good: np.ndarray) -> np.ndarray:
     return out
 
 
-def _covariance(jd, jp, r, j_envelope, cov_envelope, excess: bool):
+def _covariance(jd, jp, r, j_envelope, cov_envelope, excess: bool, bread_inv: np.ndarray):
     """(statistical, priors', T0's gain on the excess's priors): :mod:`.fit`, step 5. The statistical
-    part is the block sandwich (at least the white one) and what the envelope's own uncertainty adds (a
-    two-step estimate's correction, Murphy and Topel: H^-1 (J^T J_A) V_A (J_A^T J) H^-1, J_A the phases'
-    response to the envelope's coefficients); ``excess``: the law's excess terms are fitted (the first
-    rows after phi and omega)."""
-    bread_inv = bread(jd, jp)
-    stat_white, stat_sand, _ = white_and_blocks(jd, r, bread_inv)
+    part is the scores' long-run covariance (:func:`.spread.long_run`; at least the white one, unscaled)
+    and what the envelope's own uncertainty adds (a two-step estimate's correction, Murphy and Topel:
+    H^-1 (J^T J_A) V_A (J_A^T J) H^-1, J_A the phases' response to the envelope's coefficients);
+    ``excess``: the law's excess terms are fitted (the first rows after phi and omega); ``bread_inv``:
+    :func:`bread` of ``jd`` and ``jp``."""
+    white = bread_inv @ (jd.T @ jd) @ bread_inv
+    scores = long_run(jd, r, bread_inv)
     cross = jd.T @ j_envelope
     envelope = bread_inv @ cross @ cov_envelope @ cross.T @ bread_inv
-    cov_stat = (stat_sand if stat_sand[1, 1] > stat_white[1, 1] else stat_white) + envelope
+    cov_stat = (scores if scores[1, 1] > white[1, 1] else white) + envelope
     cov_law = bread_inv @ (jp.T @ jp) @ bread_inv
     # T0's response to the law's prior being off by one sigma in each of its excess terms (their rows
     # come first): records of one rig share that error, while a proportional record's scale is its own
@@ -372,25 +404,36 @@ class _Envelope:
     """ln A(t) of the cycles' amplitudes as a Chebyshev series in the time scaled to [-1, 1], of the
     lowest degree past which one more term does not lower chi^2 by :data:`_ENVELOPE_F` times the
     residual variance (Akaike's criterion), at most :data:`_ENVELOPE_DEGREE`: as smooth as the decay
-    the record shows and no smoother. Fitted to the amplitudes alone: let the phases move it and their
+    the record shows and no smoother; or of the ``degree`` given (the refits that weigh that choice,
+    :meth:`Model.envelope_doubt`). Fitted to the amplitudes alone: let the phases move it and their
     noise would pass for a law through it (an error in the regressor attenuates what it regresses).
-    ``cov``: the coefficients' covariance, scaled by chi^2 per degree of freedom where that is above 1."""
+    ``cov``: the coefficients' covariance, scaled by chi^2 per degree of freedom where that is above 1.
+    ``weights``: each degree's Akaike weight, exp(-QAIC / 2) normalised, QAIC = chi^2 / c + 2 (degree + 1)
+    with c the residual variance at the highest degree (the amplitudes' own variances understate
+    noise correlated within a cycle ~10x, which the quasi-likelihood's c takes out)."""
 
-    def __init__(self, t: np.ndarray, log_a: np.ndarray, sd: np.ndarray):
+    def __init__(self, t: np.ndarray, log_a: np.ndarray, sd: np.ndarray, degree: int | None = None):
         self.t0, self.t1 = float(t[0]), float(t[-1])
         n = len(t)
-        best = None
-        for degree in range(0, min(_ENVELOPE_DEGREE, n - 2) + 1):
-            x = self.basis(t, degree=degree) / sd[:, None]
+        fits = []
+        for k in range(0, min(_ENVELOPE_DEGREE, n - 2) + 1):
+            x = self.basis(t, degree=k) / sd[:, None]
             beta, *_ = np.linalg.lstsq(x, log_a / sd, rcond=None)
             r = log_a / sd - x @ beta
-            chi = float(r @ r)
-            dof = max(n - degree - 1, 1)
-            if best is not None and best[2] - chi < _ENVELOPE_F * chi / dof:
+            fits.append((k, beta, float(r @ r), max(n - k - 1, 1), x))
+        best = fits[0]
+        for fit in fits[1:]:
+            if best[2] - fit[2] < _ENVELOPE_F * fit[2] / fit[3]:
                 break
-            best = (degree, beta, chi, dof, x)
-        self.degree, self.beta, chi, dof, x = best
+            best = fit
+        if degree is not None:
+            best = fits[min(degree, len(fits) - 1)]
+        self.degree, self.beta, _, _, x = best
         self.cov = sandwich(x, log_a / sd - x @ self.beta)
+        c = max(fits[-1][2] / fits[-1][3], 1e-300)
+        qaic = np.array([chi / c + 2.0 * (k + 1) for k, _, chi, _, _ in fits])
+        w = np.exp(-0.5 * (qaic - qaic.min()))
+        self.weights = w / w.sum()
 
     def basis(self, t: np.ndarray, derivative: int = 0, degree: int | None = None) -> np.ndarray:
         from numpy.polynomial import chebyshev as C

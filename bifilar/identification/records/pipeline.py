@@ -33,6 +33,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.optimize import brentq
 from scipy.stats import chi2
 
 from bifilar.identification.identify import (
@@ -297,24 +298,40 @@ def _independent(fit: OscillationFit) -> float:
 
 
 def _own_variances(fits: list[OscillationFit]) -> np.ndarray:
-    """Each fit's own variance of T0 (:func:`_independent`), of fits of one rig (a record's halves, in
-    :func:`halves`), which share its amplitude law. Where the excesses they learned disagree (their chi^2 about
-    the weighted mean past the :data:`CONSISTENCY` quantile), what each learned is not that one law: a
-    mode near the torsion's frequency, less than a beat over a record, is to first order a law moving
-    the frequency with ln A, and each record's sway (its phase and size new each time) asks for its own
-    (:mod:`.near`). Each fit's T0 under the ideal law is then in its variance too (``law.ideal_gap``),
-    as :meth:`.phase_law.Model.check_law` holds it for a law no rig has (and then already has there)."""
+    """Each fit's own variance of T0 (:func:`_independent`), of fits of one rig (a record's halves in
+    :func:`halves`, repeated trials in :func:`pool`), which share its amplitude law. Where the excesses
+    they learned disagree (their chi^2 about the weighted mean past the :data:`CONSISTENCY` quantile),
+    what each learned is not that one law: a mode near the torsion's frequency, less than a beat over a
+    record, is to first order a law moving the frequency with ln A, and each record's sway (its phase
+    and size new each time) asks for its own (:mod:`.near`). Their spread beyond their sigmas is then
+    measured (the between-fits variance tau^2 of the excess that brings their chi^2 to its degrees of
+    freedom, Paule and Mandel's) and each fit's T0 carries it through its own response to the excess
+    (``law.ideal_gap`` over ``law.excess``: T0 under the ideal law less T0 learned, per unit of excess),
+    as :meth:`.phase_law.Model.check_law` holds a law no rig has (and then already has)."""
     own = np.array([_independent(f) for f in fits])
-    learned = [f for f in fits if f.law.excess_std > 0.0]
+    learned = [i for i, f in enumerate(fits) if f.law.excess_std > 0.0]
     if len(learned) < 2:
         return own
-    ds = np.array([f.law.excess for f in learned])
-    w = 1.0 / np.array([f.law.excess_std for f in learned]) ** 2
-    spread = float(np.sum(w * (ds - np.sum(w * ds) / np.sum(w)) ** 2))
-    if spread <= chi2.ppf(CONSISTENCY, len(learned) - 1):
+    ds = np.array([fits[i].law.excess for i in learned])
+    var = np.array([fits[i].law.excess_std for i in learned]) ** 2
+    if _dispersion(ds, var, 0.0) <= chi2.ppf(CONSISTENCY, len(learned) - 1) - (len(learned) - 1):
         return own
-    held = [f.law.conflict is not None or f.law.beat for f in fits]
-    return own + np.array([0.0 if h else f.law.ideal_gap for f, h in zip(fits, held)]) ** 2
+    # the excess's variance between fits: the dispersion falls as it grows, to zero past the plain variance
+    top = float(np.sum((ds - ds.mean()) ** 2)) / (len(learned) - 1)
+    tau2 = brentq(lambda t2: _dispersion(ds, var, t2), 0.0, top) if _dispersion(ds, var, top) < 0.0 else top
+    for i in learned:
+        f = fits[i]
+        if f.law.conflict is None and not f.law.beat and f.law.excess != 0.0:
+            own[i] += (f.law.ideal_gap / f.law.excess) ** 2 * tau2
+    return own
+
+
+def _dispersion(x: np.ndarray, var: np.ndarray, tau2: float) -> float:
+    """chi^2 of ``x`` (variances ``var``, plus ``tau2`` each) about their weighted mean, less its degrees
+    of freedom."""
+    w = 1.0 / (var + tau2)
+    mean = float(np.sum(w * x) / np.sum(w))
+    return float(np.sum(w * (x - mean) ** 2)) - (len(x) - 1)
 
 
 def file_name(record: Record) -> str:
@@ -352,7 +369,7 @@ def _flags(record: Record, fit: OscillationFit, halves: Halves | None, options: 
 
 def pool(trials: list[Trial]) -> Pooled:
     """The generalised least-squares mean of the trials' periods under their full covariance: each
-    record's own variance on the diagonal, and the law's prior part shared by all
+    record's own variance on the diagonal (:func:`_own_variances`), and the law's prior part shared by all
     (C_ij = g_i . g_j, :attr:`OscillationFit.prior_gain`); chi^2 = r^T C^-1 r over n - 1 degrees of
     freedom. Above 1 per degree of freedom the pooled sigma is scaled by its square root (Birge); above
     the :data:`CONSISTENCY` quantile the trials are called inconsistent."""
@@ -360,7 +377,7 @@ def pool(trials: list[Trial]) -> Pooled:
     gains = [tr.fit.prior_gain for tr in trials]
     width = max(len(g) for g in gains)
     g = np.array([np.pad(x, (0, width - len(x))) for x in gains]) if width else np.zeros((len(trials), 0))
-    cov = np.diag([_independent(tr.fit) for tr in trials]) + g @ g.T
+    cov = np.diag(_own_variances([tr.fit for tr in trials])) + g @ g.T
     ones = np.ones(len(t))
     inv = np.linalg.pinv(cov)
     var = 1.0 / float(ones @ inv @ ones)
