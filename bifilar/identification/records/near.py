@@ -22,9 +22,9 @@ adds, d arg(1 + eps e^(i (dw t + phi))) / dt, is a single-valued function of it,
 eps, so it is an amplitude law (in the beat's part of ln A; the damping moves ln A alone). What does tell it apart is
 that a rig has one law: records of it, or a record's two halves, each learn the beat their own
 sway's phase and size ask for. Where the excesses they learned disagree beyond their sigmas,
-:func:`.pipeline._own_variances` holds each one's T0 under the ideal law in its variance in the
-halves' test. Pooled trials do not use it yet: there it would hide that ordinary gyro trials' sigmas are
-~1.7x wide (docs/identification.md, "What is left"). One record alone stays open (issue 37 item 1).
+:func:`.pipeline._own_variances` measures their spread (the between-fits variance of the excess) and
+carries it into each one's T0, in the halves' test and in pooled trials. One record alone stays open
+(issue 37 item 1; docs/identification.md, "What is left").
 """
 
 from __future__ import annotations
