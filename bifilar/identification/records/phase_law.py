@@ -270,7 +270,7 @@ class Model:
                                                     bread_inv)
         groups = min(JACKKNIFE_GROUPS, n)
         inflation = (1.0, float(groups - 1))
-        if parent is None and groups >= 5:  # a jackknife refit is not itself jackknifed
+        if parent is None and degree is None and groups >= 5:  # the refits are not themselves jackknifed
             inflation = jackknife_inflation(j_phase, bread_inv, groups)
         return PhaseFit(
             names=tuple(names), params=p, cov_stat=cov_stat, cov_law=cov_law,
@@ -415,8 +415,9 @@ class _Envelope:
     def __init__(self, t: np.ndarray, log_a: np.ndarray, sd: np.ndarray, degree: int | None = None):
         self.t0, self.t1 = float(t[0]), float(t[-1])
         n = len(t)
+        top = min(_ENVELOPE_DEGREE, n - 2)
         fits = []
-        for k in range(0, min(_ENVELOPE_DEGREE, n - 2) + 1):
+        for k in range(0, top + 1) if degree is None else [min(degree, top)]:
             x = self.basis(t, degree=k) / sd[:, None]
             beta, *_ = np.linalg.lstsq(x, log_a / sd, rcond=None)
             r = log_a / sd - x @ beta
@@ -426,10 +427,12 @@ class _Envelope:
             if best[2] - fit[2] < _ENVELOPE_F * fit[2] / fit[3]:
                 break
             best = fit
-        if degree is not None:
-            best = fits[min(degree, len(fits) - 1)]
         self.degree, self.beta, _, _, x = best
         self.cov = sandwich(x, log_a / sd - x @ self.beta)
+        self.weights = np.zeros(top + 1)
+        if degree is not None:  # a refit at a degree given: its weight is the record's (envelope_doubt)
+            self.weights[self.degree] = 1.0
+            return
         c = max(fits[-1][2] / fits[-1][3], 1e-300)
         qaic = np.array([chi / c + 2.0 * (k + 1) for k, _, chi, _, _ in fits])
         w = np.exp(-0.5 * (qaic - qaic.min()))
