@@ -140,9 +140,9 @@ def record_near_mode(ctx: CaseContext):
     """24 gyro records of the rod (the identify-record-trials traits: 25 cycles at 250 Hz) with a sway
     within 10 % of the torsion's frequency, 2-10 % of the swing: within ~5 % it is less than ~1.5
     beats over the record and the fit cannot find it apart from the first mode. The 95 % intervals
-    should hold the truth in 90-98 % of them, as on any records (measured 18 of 24, rms z 1.98: the
-    open part of issue 37 item 1, a near mode seen in one record only; docs/identification.md "What
-    is left")."""
+    should hold the truth in 90-98 % of them, as on any records (measured 20 of 24, rms z 1.77: the
+    open part of issue 37 item 1, a near mode seen in one record whose decay it does not bend;
+    docs/identification.md "What is left")."""
     rng = np.random.default_rng(1821)
     law = AmplitudeLaw.torsion(ROD)
     zs = []

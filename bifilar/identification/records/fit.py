@@ -38,7 +38,8 @@ and assembles the result; each step is a module of its own.
    records with noise correlated within a cycle a spread of T0 as large as the rest); the prior rows
    add the law's doubt, reported apart (``period_std_law``), with the learned law's own doubts
    (:meth:`.phase_law.Model.check_law`: its extrapolation to zero swing, a law no rig has or an
-   envelope that rises again, a mode near the torsion's frequency beating in: :mod:`.near`). A
+   envelope that rises again or decays as no damping law does, a mode near the torsion's frequency
+   beating in: :mod:`.near`). A
    delete-a-group jackknife of the law's fit over 20 groups of cycles, the envelope's degree held,
    checks it (:meth:`.phase_law.Model.jackknife`): where its variance is above what it gives an honest
    covariance at 95 % (the groups at the ends move omega0 more than their share:
@@ -97,7 +98,7 @@ class Law:
     learned: float
     note: str = ""
     conflict: float | None = None  # past LAW_CONFLICT: the excess the record asked for, in prior sigmas
-    beat: bool = False  # the envelope rises again (.near.envelope_rises): the ideal law's T0 is in the sigma
+    beat: bool = False  # the envelope is not one mode's decay (.near): the ideal law's T0 is in the sigma
     ideal_gap: float = 0.0  # s, T0 under the ideal law (the excess held at zero) less T0 learned
 
     @property

@@ -1,4 +1,4 @@
-"""A second mode near the first one's frequency, seen in the envelope: damping never lifts a swing.
+"""A second mode near the first one's frequency, seen in the envelope, which one mode's damping never lifts or bends so.
 
 A sway within ~10 % of the torsion's frequency beats into the record. In the frame turning at omega0
 the analytic signal is A(t) + c2 e^(i dw t): the beat moves the complex amplitude round a circle, so
@@ -7,9 +7,11 @@ search of :mod:`.second_mode` refuses that band (the first mode sweeps it: its o
 there). To first order in its size a beat is the same as an amplitude law whose frequency moves with
 ln A at the beat frequency, and the law the record learns takes it within its prior where it makes
 less than a beat over the record: the learned law's extrapolation to zero swing then carries the beat
-into T0. What tells it apart is that damping only shrinks the swing: where the cycles' envelope rises
-again (:func:`envelope_rises`), :meth:`.phase_law.Model.check_law` holds T0 under the ideal law in the
-sigma as well, as it does for a law past its prior.
+into T0. What tells it apart is that damping only shrinks the swing, and only as a damping law does:
+where the cycles' envelope rises again (:func:`envelope_rises`) or decays as no one mode's does (two
+modes decay as two exponentials of their own rates and wobble at their beat: :func:`decay_misfit`),
+:meth:`.phase_law.Model.check_law` holds T0 under the ideal law in the sigma as well, as it does for a
+law past its prior.
 
 Searching the whole fit's residual for the near mode (a sinusoid at each trial omega2, the rest of the
 model linearised, a look-elsewhere threshold) was tried and left out: with the learned law having taken
@@ -32,6 +34,8 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from scipy.optimize import least_squares
+from scipy.stats import f as fisher
 
 NEAR_FLOOR = 1e-3  # relative rise below which a "beat" is the first mode's own law misfit
 # (:func:`.second_mode.outside`: a noiseless record's misfit fitted as a mode at 2.7e-4 of the swing)
@@ -62,3 +66,55 @@ def envelope_rises(times: np.ndarray, amplitudes: np.ndarray) -> bool:
     sigma = math.sqrt(float(np.sum((a - smooth) ** 2)) / (n - degree - 1) * (degree + 1) / n)
     rise = float(np.max(smooth - np.minimum.accumulate(smooth)))
     return rise > max(RISE_SIGMAS * sigma, NEAR_FLOOR)
+
+
+DECAY_P = 1e-6  # a decay this unlikely under one mode's damping law: two modes (:func:`decay_misfit`)
+
+
+def decay_misfit(times: np.ndarray, amplitudes: np.ndarray, sd: np.ndarray, degree: int) -> float:
+    """The p-value of the cycles' amplitudes (at their centre ``times``, ``sd`` their sds) decaying as one
+    mode's do: ln A fitted by d ln A / dt = -(a + b A + c / A), a, b, c >= 0 (linear, quadratic and dry
+    damping), against the most flexible envelope the record fit allows (a Chebyshev series of
+    ``degree``, :data:`.phase_law._ENVELOPE_DEGREE`), by the F ratio of the misfit that law adds over
+    that envelope's residual variance. A second mode near the torsion's frequency adds to the swing a
+    term of its own decay and phase: the sum's envelope wobbles at the beat, or, under half a beat,
+    bends as no damping law bends it (two exponentials of different rates)."""
+    ok = np.isfinite(amplitudes) & (amplitudes > 0.0) & np.isfinite(sd) & (sd > 0.0)
+    t, log_a, w = times[ok] - times[ok][0], np.log(amplitudes[ok]), 1.0 / sd[ok]
+    n = len(t)
+    top = min(degree, n - 2)
+    if top < 5:
+        return 1.0
+    u = 2.0 * t / max(float(t[-1]), 1e-300) - 1.0
+    x = np.polynomial.chebyshev.chebvander(u, top) * w[:, None]
+    flexible = log_a * w - x @ np.linalg.lstsq(x, log_a * w, rcond=None)[0]
+    chi_top = float(flexible @ flexible)
+    steps = np.diff(t)
+
+    def residual(p):
+        la0, a, b, c = p
+
+        def rate(v):  # d ln A / dt (v clipped: a trial step of the search may send ln A far off)
+            v = min(max(v, -700.0), 700.0)
+            return -(a + b * math.exp(v) + c * math.exp(-v))
+
+        out = np.empty(n)
+        out[0] = la = la0
+        for k, h in enumerate(steps):  # RK4 at the cycles' spacing: (rate h)^5 ~ 1e-10 of a slow decay
+            k1 = rate(la)
+            k2 = rate(la + 0.5 * h * k1)
+            k3 = rate(la + 0.5 * h * k2)
+            k4 = rate(la + h * k3)
+            la = la + h * (k1 + 2.0 * k2 + 2.0 * k3 + k4) / 6.0
+            out[k + 1] = la
+        return (out - log_a) * w
+
+    slope = max(-float(np.polyfit(t, log_a, 1)[0]), 1e-9)
+    mean = math.exp(float(np.mean(log_a)))
+    best = math.inf
+    for start in ([slope, 0.0, 0.0], [0.0, slope / mean, 0.0], [0.0, 0.0, slope * mean]):
+        fit = least_squares(residual, [log_a[0]] + start, bounds=([-np.inf, 0.0, 0.0, 0.0], np.inf), x_scale="jac")
+        best = min(best, 2.0 * fit.cost)
+    dof = top + 1 - 4
+    ratio = (best - chi_top) / dof / max(chi_top / (n - top - 1), 1e-300)
+    return float(fisher.sf(max(ratio, 0.0), dof, n - top - 1))

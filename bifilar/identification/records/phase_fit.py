@@ -77,7 +77,7 @@ class PhaseFit:
     order_shift: float = 0.0  # omega0 learned less omega0 with one excess term fewer
     held_shift: float = 0.0  # omega0 learned less omega0 under the ideal law, past LAW_CONFLICT or where it rises
     ideal_shift: float = 0.0  # the same, whatever the conflict: what a law shared with other records weighs
-    rises: bool = False  # the cycles' envelope rises again (.near.envelope_rises): a mode beating in
+    rises: bool = False  # the cycles' envelope rises again or is no damping's (.near): a mode beating in
 
     @property
     def phi0(self) -> float:

@@ -28,7 +28,7 @@ import numpy as np
 from .cycles import Cycles
 from .damping import damping_of, damping_shift
 from .law import AmplitudeLaw, Table
-from .near import envelope_rises
+from .near import DECAY_P, decay_misfit, envelope_rises
 from .phase_fit import EXCESS_TERMS, PhaseFit
 from .read import MIN_CYCLES
 from .spread import jackknife_inflation, long_run, sandwich
@@ -291,8 +291,9 @@ class Model:
         first where it is more than the sigma already holds), each the same cycles refitted:
         ``order_shift``, omega0 as fitted less omega0 with the excess's last term held at zero, and past
         :data:`LAW_CONFLICT` ``held_shift``, omega0 less omega0 with the whole excess held at the ideal law;
-        the same where the cycles' envelope rises (:func:`.near.envelope_rises`: a mode beating in, which
-        the law learns as a frequency moving with the swing, within its prior). That difference is kept
+        the same where the cycles' envelope rises (:func:`.near.envelope_rises`) or decays as no damping
+        law does (:func:`.near.decay_misfit` below :data:`.near.DECAY_P`): a mode beating in, which the law
+        learns as a frequency moving with the swing, within its prior. That difference is kept
         whatever the conflict (``ideal_shift``): fits of one rig whose learned laws disagree hold it
         (:func:`.pipeline._own_variances`).
 
@@ -304,7 +305,9 @@ class Model:
         fraction of their sigma."""
         good = cyc.good & np.isfinite(cyc.phase)
         learned = "ds" in fit.names and not fit.held
-        rises = "ds" in fit.names and envelope_rises(cyc.centre[good], cyc.fundamental[good])
+        centre, amplitude = cyc.centre[good], cyc.fundamental[good]
+        rises = "ds" in fit.names and (envelope_rises(centre, amplitude) or decay_misfit(
+            centre, amplitude, np.sqrt(cyc.amplitude_var[good]), _ENVELOPE_DEGREE) < DECAY_P)
         if not learned:
             return replace(fit, order_shift=0.0, held_shift=0.0, ideal_shift=0.0, rises=rises)
         fewer = self._solve(cyc, good, fit, free=len(EXCESS_TERMS) - 1)

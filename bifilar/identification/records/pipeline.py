@@ -355,8 +355,9 @@ def _flags(record: Record, fit: OscillationFit, halves: Halves | None, options: 
         flags.append(f"{name}: its halves disagree by {halves.z:+.2g} sigma (T0 {halves.first[0]:.7g} against "
                      f"{halves.second[0]:.7g} s): its sigma may not hold")
     if fit.law.beat:
-        flags.append(f"{name}: its swing grows again (damping only shrinks it): a mode near the torsion's frequency "
-                     "beating in, which the amplitude law learns as its own; T0's sigma holds T0 under the ideal law too")
+        flags.append(f"{name}: its swing does not decay as one mode's does (it grows again, or bends as no damping "
+                     "law bends it): a mode near the torsion's frequency beating in, which the amplitude law learns as "
+                     "its own; T0's sigma holds T0 under the ideal law too")
     if fit.law.conflict is not None:
         flags.append(f"{name}: its periods ask for an amplitude law {fit.law.conflict:.2g} prior sigmas (each "
                      f"+-{options.law_sigma:.0%} of the ideal) off the ideal rig's, more than a real rig's: T0's "
