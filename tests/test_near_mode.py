@@ -118,6 +118,18 @@ def test_fits_whose_laws_disagree_carry_their_spread_through_their_periods():
     assert np.allclose(_own_variances(fits), 1e-8 + 0.09**2 * tau2, rtol=1e-9)
 
 
+def test_an_excess_within_its_sigma_takes_the_others_response():
+    # the fits of test_fits_whose_laws_disagree_...'s, but the first learned ds = 1e-12 +- 0.005 with a
+    # gap of rounding size (3e-13 s): its ratio means nothing, and it takes the median of the others'
+    # responses (0.09 s per unit), not 0.3
+    ds = np.array([1e-12, 0.030, 0.016, 0.024, 0.006, 0.028])
+    gaps = 0.09 * ds
+    gaps[0] = 3e-13
+    fits = [_fit(d, 0.005, g) for d, g in zip(ds, gaps)]
+    tau2 = ds.var(ddof=1) - 0.005**2
+    assert np.allclose(_own_variances(fits), 1e-8 + 0.09**2 * tau2, rtol=1e-9)
+
+
 def test_the_between_fits_variance_brings_chi2_to_its_degrees_of_freedom():
     # unequal sigmas: no closed form; the excesses' chi^2 about their weighted mean, each variance
     # widened by what _own_variances found (over the slopes' squares), is their 3 degrees of freedom

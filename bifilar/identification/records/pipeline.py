@@ -319,10 +319,15 @@ def _own_variances(fits: list[OscillationFit]) -> np.ndarray:
     # the excess's variance between fits: the dispersion falls as it grows, to zero past the plain variance
     top = float(np.sum((ds - ds.mean()) ** 2)) / (len(learned) - 1)
     tau2 = brentq(lambda t2: _dispersion(ds, var, t2), 0.0, top) if _dispersion(ds, var, top) < 0.0 else top
+    # T0 per unit of excess, where the excess stands out of its sigma (else the ratio of two roundings):
+    # the others take the median of those (the fits of one rig swing alike)
+    slopes = {i: abs(fits[i].law.ideal_gap / fits[i].law.excess) for i in learned
+              if abs(fits[i].law.excess) > fits[i].law.excess_std}
+    typical = float(np.median(list(slopes.values()))) if slopes else 0.0
     for i in learned:
         f = fits[i]
-        if f.law.conflict is None and not f.law.beat and f.law.excess != 0.0:
-            own[i] += (f.law.ideal_gap / f.law.excess) ** 2 * tau2
+        if f.law.conflict is None and not f.law.beat:
+            own[i] += slopes.get(i, typical) ** 2 * tau2
     return own
 
 
