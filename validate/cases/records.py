@@ -171,7 +171,7 @@ def record_near_trials(ctx: CaseContext):
     record's halves agree within 3 sigma in at least 90 % of them (issue 37's figures). A sway of half a
     beat or less over the record is taken by the learned law within its prior, each trial's its own:
     the trials' laws disagree, and their spread enters each trial's variance
-    (:func:`bifilar.identification.records.pipeline.pool`; measured 0.482 and 45 of 48; 6.79 and 46 of
+    (:func:`bifilar.identification.records.pipeline.pool`; measured 0.489 and 45 of 48; 6.79 and 46 of
     48 before stop 49)."""
     rng = np.random.default_rng(3701)
     law = AmplitudeLaw.torsion(ROD)
