@@ -253,8 +253,7 @@ def _result(rec: Samples, t: np.ndarray, cyc: Cycles, model: Model, phase: Phase
     std_law = to_period * math.sqrt(phase.cov_law[1, 1] + held)
     std_all = to_period * math.sqrt(base + order)
     std_stat = math.sqrt(max(std_all**2 - std_law**2, to_period**2 * whole.variance))
-    jack, groups = model.jackknife(phase, cyc)
-    ratio, dof = phase.jackknife_inflation
+    jack, groups, ratio, dof = model.jackknife(phase, cyc)
     if not (groups and jack > (std_stat / to_period) ** 2 * ratio * chi2.ppf(0.95, dof) / dof):
         groups = 0  # the covariance holds: the jackknife is not above what it gives an honest one at 95 %
     else:  # the covariance is short: the jackknife's over its leverage, to its Student-t interval

@@ -28,9 +28,10 @@ class PhaseFit:
     ``names``: the parameters (phi, omega, then the law's: the excess terms, the scale ``q`` or ``kappa``
     of a proportional record), ``params`` their values (``phi0`` and ``omega0`` the first two). ``cov_stat``, ``cov_law``:
     their covariance, the record's noise (block sandwich plus the envelope's doubt) and the priors' part;
-    ``prior_gain``: omega0's response to each excess prior off by one sigma. ``jackknife_inflation``: what
-    the jackknife of omega0 gives over its variance where the errors are white, and its degrees of
-    freedom (:func:`.spread.jackknife_inflation`). ``envelope_degree``, ``envelope_weights``: the
+    ``prior_gain``: omega0's response to each excess prior off by one sigma. ``j_phase``, ``bread``: the
+    good cycles' weighted phase Jacobian and the inverse normal matrix (priors included), from which
+    the jackknife's expected ratio is derived (:func:`.spread.jackknife_inflation`, in
+    :meth:`.phase_law.Model.jackknife`). ``envelope_degree``, ``envelope_weights``: the
     envelope's degree and each degree's Akaike weight (:class:`.phase_law._Envelope`). ``residual``, ``var``: each
     good cycle's phase residual (rad) and variance. ``ideal``: the ideal law's coefficient s (1/rad^2;
     None for the linear law). ``conflict``: the largest excess at a swing the record went through, in
@@ -52,7 +53,8 @@ class PhaseFit:
     cov_stat: np.ndarray
     cov_law: np.ndarray
     prior_gain: np.ndarray
-    jackknife_inflation: tuple[float, float]
+    j_phase: np.ndarray
+    bread: np.ndarray
     envelope_degree: int
     envelope_weights: np.ndarray
     residual: np.ndarray

@@ -268,13 +268,9 @@ class Model:
         bread_inv = bread(j_phase, jp)
         cov_stat, cov_law, prior_gain = _covariance(j_phase, jp, r_phase, j_envelope, envelope.cov, "ds" in names,
                                                     bread_inv)
-        groups = min(JACKKNIFE_GROUPS, n)
-        inflation = (1.0, float(groups - 1))
-        if parent is None and degree is None and groups >= 5:  # the refits are not themselves jackknifed
-            inflation = jackknife_inflation(j_phase, bread_inv, groups)
         return PhaseFit(
             names=tuple(names), params=p, cov_stat=cov_stat, cov_law=cov_law,
-            prior_gain=prior_gain, jackknife_inflation=inflation, envelope_degree=envelope.degree,
+            prior_gain=prior_gain, j_phase=j_phase, bread=bread_inv, envelope_degree=envelope.degree,
             envelope_weights=envelope.weights, residual=r_phase / weights, var=var, ideal=s if law_on else None,
             conflict=conflict, held=held, scale_known=self.kind != "proportional" or "kappa" in names or "q" in names,
             damping=damping, shift_curve=shift_curve, harmonic=harmonic, table=table, table_key=table_key,
@@ -315,18 +311,19 @@ class Model:
         return replace(fit, order_shift=fit.omega0 - fewer.omega0, ideal_shift=ideal_shift, rises=rises,
                        held_shift=ideal_shift if fit.conflict > LAW_CONFLICT or rises else 0.0)
 
-    def jackknife(self, fit: PhaseFit, cyc: Cycles) -> tuple[float, int]:
-        """(variance of omega0, groups): the delete-a-group jackknife of ``fit`` over up to
+    def jackknife(self, fit: PhaseFit, cyc: Cycles) -> tuple[float, int, float, float]:
+        """(variance of omega0, groups, ratio, dof): the delete-a-group jackknife of ``fit`` over up to
         :data:`JACKKNIFE_GROUPS` contiguous groups of the good cycles, each refitted whole (waveform,
         envelope and phases) with the envelope's degree held (the doubt of that choice is
         :meth:`envelope_doubt`'s). It sees the paths by which a record's noise reaches omega0 that the
         covariance does not model (the law's shape misfit, what moves a cycle's phase and amplitude
-        together); of an honest covariance it gives ``fit.jackknife_inflation``'s ratio (the groups at
-        the ends move omega0 more than their share), which :mod:`.fit` tests it against."""
+        together); of an honest covariance it gives ``ratio`` times omega0's variance, a variance of
+        ``dof`` degrees of freedom (:func:`.spread.jackknife_inflation`: the groups at the ends move
+        omega0 more than their share), which :mod:`.fit` tests it against."""
         good = np.flatnonzero(cyc.good & np.isfinite(cyc.phase))
         groups = min(JACKKNIFE_GROUPS, len(good))
         if groups < 5:
-            return 0.0, 0
+            return 0.0, 0, 1.0, 1.0
         start = fit
         if self.law.kind != "linear":  # the refits' table: at their starting omega0, and room for
             key, table = self._table(fit, fit.omega0, 1.2 * fit.table_key[1])  # an envelope a little higher
@@ -337,7 +334,8 @@ class Model:
             keep[part] = False
             omegas.append(self._solve(cyc, keep, start, parent=fit, degree=fit.envelope_degree).omega0)
         omegas = np.array(omegas)
-        return float((groups - 1) / groups * np.sum((omegas - omegas.mean()) ** 2)), groups
+        ratio, dof = jackknife_inflation(fit.j_phase, fit.bread, groups)
+        return float((groups - 1) / groups * np.sum((omegas - omegas.mean()) ** 2)), groups, ratio, dof
 
     def envelope_doubt(self, fit: PhaseFit, cyc: Cycles) -> float:
         """The variance of omega0 (rad^2/s^2) that choosing the envelope's degree adds (Buckland, Burnham

@@ -30,10 +30,16 @@ def white_and_blocks(x: np.ndarray, r: np.ndarray, bread_inv: np.ndarray):
     n, k = x.shape
     white = bread_inv @ (x.T @ x) @ bread_inv * max(1.0, float(r @ r) / max(n - k, 1))
     block = block_length(r)
-    blocks = np.add.reduceat(x * r[:, None], np.arange(0, n, block), axis=0)
-    nb = len(blocks)
-    sand = bread_inv @ (blocks.T @ blocks) @ bread_inv * (nb / max(nb - 1, 1)) * (n / max(n - k, 1))
+    sand = bread_inv @ _block_meat(x * r[:, None], block) @ bread_inv * (n / max(n - k, 1))
     return white, sand, block
+
+
+def _block_meat(scores: np.ndarray, block: int) -> np.ndarray:
+    """The batch-means meat of a sandwich: the ``scores`` (a row per cycle) summed over blocks of
+    ``block`` neighbours, the sums' outer product over the blocks times nb / (nb - 1)."""
+    sums = np.add.reduceat(scores, np.arange(0, len(scores), block), axis=0)
+    nb = len(sums)
+    return sums.T @ sums * (nb / max(nb - 1, 1))
 
 
 def long_run(x: np.ndarray, r: np.ndarray, bread_inv: np.ndarray) -> np.ndarray:
@@ -52,9 +58,7 @@ def long_run(x: np.ndarray, r: np.ndarray, bread_inv: np.ndarray) -> np.ndarray:
     scores = x * r[:, None]
     block = block_length(r)
     if block > 1:
-        sums = np.add.reduceat(scores, np.arange(0, n, block), axis=0)
-        nb = len(sums)
-        meat = sums.T @ sums * (nb / max(nb - 1, 1))
+        meat = _block_meat(scores, block)
     else:
         meat = scores.T @ scores
         for lag in (1, 2):
