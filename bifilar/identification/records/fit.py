@@ -72,6 +72,7 @@ from .bounds import Deadline, binned
 from .clean import Rejected, spans, stuck
 from .cycles import Cycles, Samples, baseline_of, measure, rough_frequency
 from .law import EXCESS_PRIOR, LINEAR, AmplitudeLaw
+from .near import near_doubt, near_mode_of
 from .phase_fit import EXCESS_TERMS, PhaseFit
 from .phase_law import LAW_CONFLICT, Model, pendulum, swing_of, unwrap
 from .read import KINDS, MIN_CYCLES, MIN_SAMPLES
@@ -207,8 +208,16 @@ def fit_oscillation(t, y, kind: str, law: AmplitudeLaw = LINEAR, *, excess_prior
         baseline = baseline + baseline_of(rec.tau, cyc)  # the offsets left under the last baseline
     cyc = measure(rec, baseline, phase.local, second)
     phase = model.check_law(model.fit(cyc, phase, slips=True), cyc)
+    near = near_mode_of(cyc, phase, rec.kind == "rate", model.prior) if second_mode and second is None else None
+    if near is not None:  # a mode near the torsion's frequency, found by its beat: subtracted, the law refitted
+        second = near
+        for _ in range(2):
+            cyc = measure(rec, baseline, phase.local, second)
+            phase = model.fit(cyc, phase)
+        phase = model.check_law(model.fit(cyc, phase, slips=True), cyc)
     whole = fit_whole(rec, cyc, phase, baseline, second)
-    return _result(rec, t, cyc, model, phase, baseline, whole, rejected, law.kind)
+    doubt = 0.0 if whole.second is None else near_doubt(cyc, phase, rec.kind == "rate", model.prior, whole.second, second)
+    return _result(rec, t, cyc, model, phase, baseline, whole, rejected, law.kind, doubt)
 
 
 class SwingError(ValueError):
@@ -234,7 +243,7 @@ def _check_swing(cyc: Cycles, law: AmplitudeLaw, kind: str) -> None:
 
 
 def _result(rec: Samples, t: np.ndarray, cyc: Cycles, model: Model, phase: PhaseFit, baseline: np.ndarray,
-            whole: Whole, rejected: Rejected, ideal_kind: str = "linear") -> OscillationFit:
+            whole: Whole, rejected: Rejected, ideal_kind: str = "linear", near: float = 0.0) -> OscillationFit:
     good = cyc.good & np.isfinite(cyc.phase)
     omega0 = whole.omega0
     period = 2.0 * math.pi / omega0
@@ -260,6 +269,8 @@ def _result(rec: Samples, t: np.ndarray, cyc: Cycles, model: Model, phase: Phase
         std_stat = max(std_stat, to_period * math.sqrt(jack / ratio * few_blocks(groups)))
     # what choosing the envelope's degree adds, which neither holds (the jackknife keeps the degree)
     std_stat = math.hypot(std_stat, to_period * math.sqrt(model.envelope_doubt(phase, cyc)))
+    # and what a mode near the torsion's frequency adds by trading with the law (``near``: .near.near_doubt)
+    std_stat = math.hypot(std_stat, to_period * math.sqrt(near))
     std_white = to_period * math.sqrt(whole.variance_white)
     second = whole.second
     fitted = np.full(len(t), np.nan)

@@ -34,8 +34,14 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from scipy.integrate import cumulative_trapezoid
 from scipy.optimize import least_squares
 from scipy.stats import f as fisher
+
+from .cycles import Cycles
+from .phase_fit import PhaseFit
+from .read import MIN_CYCLES
+from .second_mode import SECOND_DECAY_SPANS, Second
 
 NEAR_FLOOR = 1e-3  # relative rise below which a "beat" is the first mode's own law misfit
 # (:func:`.second_mode.outside`: a noiseless record's misfit fitted as a mode at 2.7e-4 of the swing)
@@ -120,3 +126,175 @@ def decay_misfit(times: np.ndarray, amplitudes: np.ndarray, sd: np.ndarray, degr
     dof = top + 1 - 4
     ratio = (best - chi_top) / dof / max(chi_top / (n - top - 1), 1e-300)
     return float(fisher.sf(max(ratio, 0.0), dof, n - top - 1))
+
+
+NEAR_BAND = 0.15  # a near mode is searched within this relative distance of the first mode's frequency
+NEAR_GAIN = 25.0  # the two-mode fit's chi^2 below the one-mode fit's, in its own residual variances: a mode
+_NEAR_SHARE = 0.5  # the largest near mode, relative to the first mode's swing in the record's middle
+_ENVELOPE_ONE = 6  # the one-mode fit's envelope degree (ln A): as many parameters as the two-mode fit's
+_ENVELOPE_TWO = 2  # the first mode's own envelope beside a near mode: damping's smooth decay
+
+
+def near_mode_of(cyc: Cycles, law_fit: PhaseFit, rate: bool, prior: float) -> Second | None:
+    """A second mode within :data:`NEAR_BAND` of the torsion's frequency, fitted to the cycles' complex
+    fundamentals z_k = a_k e^(i phi_k) (:mod:`.cycles`: a window one local period long takes all of a
+    near mode into its fundamental, times sinc((omega2 - omega_k) / omega_k)) as the sum of the first
+    mode, e^(P(t) + i Phi(t)) with ln A = P a quadratic (damping's smooth decay) and
+    Phi = phi0 + omega0 int dt / (R(A) E(A)) (the ideal law R, its excess E = 1 + ds A^2 + dq A^4 under
+    its ``prior``, A in rad: a rate's fundamental over omega0), and a damped sinusoid
+    C e^((-decay + i omega2) t). Against it one mode alone with an envelope of degree
+    :data:`_ENVELOPE_ONE` (as many parameters): the beat's wobble of the envelope it follows, but the
+    phase's, of the same size in quadrature, only a law far past its prior would. None unless the two
+    modes' chi^2 is :data:`NEAR_GAIN` of its own residual variances below the one mode's (a mode, not
+    noise: the search over omega2 looks in many places), and the near mode is at most
+    :data:`_NEAR_SHARE` of the first, at least :data:`NEAR_FLOOR` of it (below, the first mode's own
+    law misfit: a noiseless 100-cycle record's fitted as a mode of 1.1e-4 at 1.058 T0), and lasts the
+    record. The residuals are each cycle's phase and
+    ln a, over their sigmas."""
+    data = _Near.of(cyc, law_fit, rate, prior)
+    if data is None:
+        return None
+    one = data.fit(_ENVELOPE_ONE)
+    two = None
+    for start in data.starts(data.fit(_ENVELOPE_TWO)):
+        sol = data.fit(_ENVELOPE_TWO, start)
+        if two is None or sol.cost < two.cost:
+            two = sol
+    if two is None:
+        return None
+    gain = (one.cost - two.cost) / max(two.cost / data.dof(two), 1e-300)
+    first = math.exp(float(np.polynomial.chebyshev.chebval(0.0, two.x[2:3 + _ENVELOPE_TWO])))  # in the middle
+    omega2, decay, c = float(two.x[-4]), float(two.x[-3]), complex(two.x[-2], two.x[-1])
+    if (gain < NEAR_GAIN or not NEAR_FLOOR * first <= abs(c) <= _NEAR_SHARE * first
+            or abs(omega2 / two.x[1] - 1.0) > NEAR_BAND):
+        return None
+    c = c * np.exp((decay - 1j * omega2) * data.middle)  # the amplitude at tau = 0
+    return Second(omega2, decay, float(c.real), float(-c.imag), near=True)
+
+
+def near_doubt(cyc: Cycles, law_fit: PhaseFit, rate: bool, prior: float, second: Second,
+               subtracted: Second | None) -> float:
+    """What a second mode within :data:`NEAR_BAND` of the torsion's frequency adds to omega0's variance
+    ((rad/s)^2) by trading with the law: to first order in its size a beat is an amplitude law
+    (module docstring), so the law the record learns and the mode fitted beside it share what the
+    record says of them, which the law's fit, the mode held, does not see. The cycles' two-mode model
+    of :func:`near_mode_of` is fitted from ``second``, the cycles measured with ``subtracted`` taken
+    from the record (put back here); the difference of omega0's variance with
+    the mode free and held, both scaled by that fit's chi^2 / dof where above 1, is the doubt. 0 where the
+    mode lies outside the band or the cycles are too few."""
+    data = _Near.of(cyc, law_fit, rate, prior, subtracted)
+    if data is None or abs(second.omega / law_fit.omega0 - 1.0) > NEAR_BAND:
+        return 0.0
+    base = data.fit(_ENVELOPE_TWO)
+    c = complex(second.c, -second.s) * np.exp((-second.decay + 1j * second.omega) * data.middle)
+    two = data.fit(_ENVELOPE_TWO, np.concatenate([base.x, [second.omega, second.decay, c.real, c.imag]]))
+    scale = max(2.0 * two.cost / data.dof(two), 1.0)
+    jac = two.jac
+    free = np.linalg.pinv(jac.T @ jac)[1, 1]
+    held = np.linalg.pinv(jac[:, :-4].T @ jac[:, :-4])[1, 1]
+    return scale * max(free - held, 0.0)
+
+
+class _Near:
+    """The cycles' complex fundamentals and the one- and two-mode models of :func:`near_mode_of`:
+    p = (phi0, omega0, ln A's Chebyshev terms, the excess's two terms in prior sigmas[, omega2, decay,
+    Re C, Im C]), times from the record's middle."""
+
+    @classmethod
+    def of(cls, cyc: Cycles, law_fit: PhaseFit, rate: bool, prior: float, add: Second | None = None) -> _Near | None:
+        """The good cycles' (None: fewer than 12), the law's phase unwrapping them; ``add``: a mode
+        subtracted from the record before the cycles were measured, put back."""
+        good = np.flatnonzero(cyc.good & np.isfinite(cyc.phase) & (cyc.phase_var > 0.0) & (cyc.amplitude_var > 0.0))
+        if len(good) < max(MIN_CYCLES, 12):
+            return None
+        t, omega = cyc.centre[good], cyc.omega[good]
+        z = cyc.fundamental[good] * np.exp(1j * cyc.phase[good])
+        if add is not None:
+            z = z + complex(add.c, -add.s) * np.exp((-add.decay + 1j * add.omega) * t) * np.sinc((add.omega - omega) / omega)
+        law_phase = law_fit.phase_at(t)
+        phase = law_phase + np.angle(z * np.exp(-1j * law_phase))
+        # the ideal law's table, where the swing in rad is known; its excess E = 1 + width (e1 A^2 + e2 A^4)
+        lawful = law_fit.table is not None and law_fit.ideal is not None and law_fit.scale_known and prior > 0.0
+        width = prior * abs(law_fit.ideal) if lawful else 0.0
+        return cls(t, phase, np.abs(z), np.sqrt(cyc.phase_var[good]),
+                   np.sqrt(cyc.amplitude_var[good]) / cyc.fundamental[good], omega,
+                   law_fit.table if law_fit.table is not None and law_fit.scale_known else None, width, rate)
+
+    def __init__(self, t, phase, amplitude, sd_phase, sd_log, omega, table, width, rate):
+        self.t, self.phase, self.sd_phase, self.sd_log, self.omega = t, phase, sd_phase, sd_log, omega
+        self.z = amplitude * np.exp(1j * phase)
+        self.log_a = np.log(amplitude)
+        self.table, self.width, self.rate = table, width, rate
+        self.middle = 0.5 * (t[0] + t[-1])
+        self.half = max(0.5 * (t[-1] - t[0]), 1e-300)
+        self.grid = np.linspace(t[0], t[-1], 8 * len(t))  # the law's phase integral, trapezoid
+
+    def dof(self, sol) -> int:
+        return max(2 * len(self.t) + 2 - len(sol.x), 1)
+
+    def law_phase(self, omega0: float, envelope: np.ndarray, excess: np.ndarray) -> np.ndarray:
+        """int_middle^t dt / (R(A) E(A)) (s) at the cycles: the ideal law R (none where the swing in rad
+        is not known), A the first mode's own peak swing (rad: a rate's fundamental over omega0)."""
+        if self.table is None:
+            return self.t - self.middle
+        a = np.exp(np.polynomial.chebyshev.chebval((self.grid - self.middle) / self.half, envelope))
+        a = np.minimum(a / omega0 if self.rate else a, self.table.largest)
+        a2 = a * a
+        rate = 1.0 / (self.table.ratio_at(a) * (1.0 + self.width * (excess[0] * a2 + excess[1] * a2 * a2)))
+        q = cumulative_trapezoid(rate, self.grid, initial=0.0)
+        return np.interp(self.t, self.grid, q) - np.interp(self.middle, self.grid, q)
+
+    def model(self, p: np.ndarray, degree: int, second: bool) -> np.ndarray:
+        """The complex fundamental at the cycles."""
+        envelope = p[2:3 + degree]
+        u = self.t - self.middle
+        log_a = np.polynomial.chebyshev.chebval(u / self.half, envelope)
+        z = np.exp(log_a + 1j * (p[0] + p[1] * self.law_phase(p[1], envelope, p[3 + degree:5 + degree])))
+        if second:
+            omega2, decay, cr, ci = p[5 + degree:9 + degree]
+            z = z + complex(cr, ci) * np.exp((-decay + 1j * omega2) * u) * np.sinc((omega2 - self.omega) / self.omega)
+        return z
+
+    def residual(self, p: np.ndarray, degree: int, second: bool) -> np.ndarray:
+        q = self.z / self.model(p, degree, second)
+        return np.concatenate([np.angle(q) / self.sd_phase, np.log(np.abs(q)) / self.sd_log, p[3 + degree:5 + degree]])
+
+    def fit(self, degree: int, start: np.ndarray | None = None):
+        """The least squares of one mode (``start`` None: from the envelope's and the phase's linear
+        fits) or of two (from ``start``)."""
+        second = start is not None
+        if start is None:
+            u = self.t - self.middle
+            envelope = np.polynomial.chebyshev.chebfit(u / self.half, self.log_a, degree)
+            w0 = np.polyfit(u, self.phase, 1)[0]
+            omega0, phi0 = np.polyfit(self.law_phase(w0, envelope, np.zeros(2)), self.phase, 1)
+            start = np.concatenate([[phi0, omega0], envelope, [0.0, 0.0]])
+        lo, hi = np.full(len(start), -np.inf), np.full(len(start), np.inf)
+        if second:  # a mode beating in lasts the record (:func:`.second_mode.second_mode_of`)
+            lo[-3], hi[-3] = 0.0, SECOND_DECAY_SPANS / (2.0 * self.half)
+        start = np.clip(start, lo, hi)
+        return least_squares(self.residual, start, args=(degree, second), bounds=(lo, hi), x_scale="jac")
+
+    def starts(self, base) -> list[np.ndarray]:
+        """Two-mode starts from the one-mode fit ``base``: the three highest peaks, a resolution apart,
+        of the periodogram of what it leaves (z / z1 - 1) |z1| over omega2 within NEAR_BAND."""
+        p = base.x
+        z1 = self.model(p, _ENVELOPE_TWO, False)
+        rest = (self.z / z1 - 1.0) * np.abs(z1)
+        weight = 1.0 / self.sd_phase**2
+        u = self.t - self.middle
+        resolution = math.pi / self.half
+        grid = p[1] * (1.0 + np.linspace(-NEAR_BAND, NEAR_BAND, 401))
+        shifts = np.exp(-1j * np.outer(grid - p[1], u))
+        power = np.abs(shifts @ (weight * rest))
+        picked = []
+        for j in np.argsort(power)[::-1]:
+            if all(abs(grid[j] - g) > resolution for g in picked):
+                picked.append(grid[j])
+            if len(picked) == 3:
+                break
+        out = []
+        for omega2 in picked:
+            c = np.sum(weight * rest * np.exp(-1j * (omega2 - p[1]) * u)) / np.sum(weight) * np.exp(1j * p[0])
+            out.append(np.concatenate([p, [omega2, 0.1 / (2.0 * self.half), c.real, c.imag]]))
+        return out

@@ -78,12 +78,14 @@ def swept_band(law_fit: PhaseFit, centres: np.ndarray) -> tuple[float, float]:
 
 @dataclass(frozen=True)
 class Second:
-    """A damped sinusoid e^(-decay tau) (c cos + s sin)(omega tau) superposed on the record."""
+    """A damped sinusoid e^(-decay tau) (c cos + s sin)(omega tau) superposed on the record; ``near``: within
+    the band the first mode sweeps (:func:`.near.near_mode_of`), found by the beat, not the periodogram."""
 
     omega: float
     decay: float
     c: float
     s: float
+    near: bool = False
 
     def signal(self, tau):
         return np.exp(-self.decay * tau) * (self.c * np.cos(self.omega * tau) + self.s * np.sin(self.omega * tau))

@@ -79,16 +79,16 @@ def fit_whole(rec: Samples, cyc: Cycles, law_fit: PhaseFit, baseline: np.ndarray
     largest = _SECOND_SHARE * float(np.max(envelope))
     swept = swept_band(law_fit, cyc.centre[good])
 
-    def plausible(f) -> bool:
+    def plausible(f, near: bool = False) -> bool:
         """Its second mode at most _SECOND_SHARE of the first (a law misfit near the first mode's
         frequency would pass for one of comparable size) and apart from the band the first mode swept
-        (:func:`.second_mode.outside`)."""
+        (:func:`.second_mode.outside`), unless the beat found it there (``near``: :mod:`.near`)."""
         scaled = tuple(w * f[0][1] / law_fit.omega0 for w in swept)
         return (math.hypot(*f[3][-2:]) * math.exp(-f[0][5] * tau[0]) <= largest
-                and outside(float(f[0][4]), scaled, span))
+                and (near or outside(float(f[0][4]), scaled, span)))
 
     fit = _whole_fit(tau, y, u, integral, envelope, level, harmonics, first, second)
-    if second is not None and not plausible(fit):
+    if second is not None and not plausible(fit, second.near):
         second = None
         fit = _whole_fit(tau, y, u, integral, envelope, level, harmonics, first, None)
     if second is None:
@@ -113,7 +113,7 @@ def fit_whole(rec: Samples, cyc: Cycles, law_fit: PhaseFit, baseline: np.ndarray
     refined = None
     if second is not None:
         c2, s2 = beta[-2:]
-        refined = Second(float(q[4]), float(q[5]), float(c2), float(s2))
+        refined = Second(float(q[4]), float(q[5]), float(c2), float(s2), second.near)
     # the law's parameters, held here, in the bound with their priors: the fundamental's response to them
     # (the harmonics' and a rate's envelope's, a few % of it, left out)
     law = (np.exp(q[2] + q[3] * u) * envelope * np.sin(q[0] + q[1] * integral))[:, None] * q[1] \
