@@ -22,7 +22,11 @@ and assembles the result; each step is a module of its own.
    rad off the law: the tracker jumped).
 3. A second mode (:mod:`.second_mode`): a peak of the periodogram of the record less the law's first
    mode, away from the first mode's harmonics, is fitted as a damped sinusoid, subtracted and the cycles
-   refitted; one the cycles do not show is looked for again in the whole fit's residual (step 6).
+   refitted; one the cycles do not show is looked for again in the whole fit's residual (step 6). One
+   within 15 % of the torsion's frequency, where the periodogram cannot look or where the law took part
+   of its beat, is found by the beat itself (:mod:`.near`: the cycles' phase and envelope wobbling
+   together), fitted beside the first mode, subtracted and the law refitted; what its trade with the
+   law does to omega0 is added to the sigma (:func:`.near.near_doubt`).
 4. The law (:mod:`.phase_law`, the ideal law: :mod:`.law`): the phases follow Phi(t) = phi0 + omega0 int
    dt / (R(A(t)) E(A(t)) D(t)), A(t) the peak amplitude (the cycles' amplitudes through the law's
    waveform, ln A a Chebyshev series of the degree Akaike's criterion allows: :class:`.phase_law._Envelope`), R
@@ -72,7 +76,7 @@ from .bounds import Deadline, binned
 from .clean import Rejected, spans, stuck
 from .cycles import Cycles, Samples, baseline_of, measure, rough_frequency
 from .law import EXCESS_PRIOR, LINEAR, AmplitudeLaw
-from .near import near_doubt, near_mode_of
+from .near import NEAR_BAND, near_doubt, near_mode_of, near_refit
 from .phase_fit import EXCESS_TERMS, PhaseFit
 from .phase_law import LAW_CONFLICT, Model, pendulum, swing_of, unwrap
 from .read import KINDS, MIN_CYCLES, MIN_SAMPLES
@@ -208,7 +212,12 @@ def fit_oscillation(t, y, kind: str, law: AmplitudeLaw = LINEAR, *, excess_prior
         baseline = baseline + baseline_of(rec.tau, cyc)  # the offsets left under the last baseline
     cyc = measure(rec, baseline, phase.local, second)
     phase = model.check_law(model.fit(cyc, phase, slips=True), cyc)
-    near = near_mode_of(cyc, phase, rec.kind == "rate", model.prior) if second_mode and second is None else None
+    near = None
+    if second_mode and second is None:
+        near = near_mode_of(cyc, phase, rec.kind == "rate", model.prior)
+    elif second is not None and abs(second.omega / phase.omega0 - 1.0) <= NEAR_BAND:
+        near = near_refit(cyc, phase, rec.kind == "rate", model.prior, second)
+        near = near if near.near else None
     if near is not None:  # a mode near the torsion's frequency, found by its beat: subtracted, the law refitted
         second = near
         for _ in range(2):

@@ -1,32 +1,40 @@
-"""A second mode near the first one's frequency, seen in the envelope, which one mode's damping never lifts or bends so.
+"""A second mode near the first one's frequency: found by its beat, fitted beside the first mode, its
+trade with the law carried into the sigma; and, where it cannot be fitted, seen in an envelope that one
+mode's damping never lifts or bends so.
 
 A sway within ~10 % of the torsion's frequency beats into the record. In the frame turning at omega0
 the analytic signal is A(t) + c2 e^(i dw t): the beat moves the complex amplitude round a circle, so
 the envelope and the phase wobble together, of the same relative size, in quadrature. The periodogram
-search of :mod:`.second_mode` refuses that band (the first mode sweeps it: its own law misfit stands
-there). To first order in its size a beat is the same as an amplitude law whose frequency moves with
-ln A at the beat frequency, and the law the record learns takes it within its prior where it makes
-less than a beat over the record: the learned law's extrapolation to zero swing then carries the beat
-into T0. What tells it apart is that damping only shrinks the swing, and only as a damping law does:
-where the cycles' envelope rises again (:func:`envelope_rises`) or decays as no one mode's does (two
-modes decay as two exponentials of their own rates and wobble at their beat: :func:`decay_misfit`),
-:meth:`.phase_law.Model.check_law` holds T0 under the ideal law in the sigma as well, as it does for a
-law past its prior.
+search of :mod:`.second_mode` refuses the band the first mode sweeps (its own law misfit stands there),
+and where it finds the sway just outside that band it fits it beside the law as the law was fitted, a
+law that took part of the beat. To first order in its size a beat is an amplitude law whose frequency
+moves with ln A at the beat frequency: a law free to move takes it, and extrapolates it into T0.
 
-Searching the whole fit's residual for the near mode (a sinusoid at each trial omega2, the rest of the
-model linearised, a look-elsewhere threshold) was tried and left out: with the learned law having taken
-the beat, the residual showed the beat's mirror image (a sway at 0.963 omega0 turned up at 1.035) and
-joint fits wandered (rms z 3.24 against 1.43 without it, ``benchmarks/near_mode.py``).
+:func:`near_mode_of` fits the cycles' complex fundamentals as the first mode (its own smooth envelope,
+the ideal law's phase with the excess under its prior) plus a damped sinusoid within
+:data:`NEAR_BAND`, against one mode with an envelope free to follow the wobble: the law, held to its
+prior, cannot follow the phase's. Where the two modes fit better by :data:`NEAR_GAIN` of their own
+residual variances, the mode is subtracted from the record and the law refitted without it
+(:func:`near_refit` refits one the periodogram found in the band the same way). Mode and law still
+trade what the record says of them: :func:`near_doubt` adds to omega0's variance what freeing the mode
+adds in that fit. Searching the whole fit's residual instead (a sinusoid at each trial omega2, the rest
+linearised) was tried and left out: with the learned law having taken the beat, the residual showed
+the beat's mirror image (a sway at 0.963 omega0 turned up at 1.035) and joint fits wandered
+(``benchmarks/near_mode.py``).
 
-Half a beat or less over one record cannot be told from a law at all: while the beat's phase
+Half a beat or less over one record is often not told from a law at all: while the beat's phase
 dw t + phi sweeps less than pi, the envelope's share of it moves one way, and the frequency the beat
-adds, d arg(1 + eps e^(i (dw t + phi))) / dt, is a single-valued function of it, to every order in
-eps, so it is an amplitude law (in the beat's part of ln A; the damping moves ln A alone). What does tell it apart is
-that a rig has one law: records of it, or a record's two halves, each learn the beat their own
-sway's phase and size ask for. Where the excesses they learned disagree beyond their sigmas,
-:func:`.pipeline._own_variances` measures their spread (the between-fits variance of the excess) and
-carries it into each one's T0, in the halves' test and in pooled trials. One record alone stays open
-(issue 37 item 1; docs/identification.md, "What is left").
+adds, d arg(1 + eps e^(i (dw t + phi))) / dt, is a single-valued function of it, to every order in eps,
+so it is an amplitude law (in the beat's part of ln A; the damping moves ln A alone). What tells it
+apart then is that damping only shrinks the swing, and only as a damping law does: where the cycles'
+envelope rises again (:func:`envelope_rises`) or decays as no one mode's does (two modes decay as two
+exponentials of their own rates and wobble at their beat: :func:`decay_misfit`),
+:meth:`.phase_law.Model.check_law` holds T0 under the ideal law in the sigma as well, as it does for a
+law past its prior. And a rig has one law: records of it, or a record's two halves, each learn the
+beat their own sway's phase and size ask for; where the excesses they learned disagree beyond their
+sigmas, :func:`.pipeline._own_variances` measures their spread and carries it into each one's T0, in
+the halves' test and in pooled trials. A sway under a beat that neither shows stays open (issue 37
+item 1; docs/identification.md, "What is left").
 """
 
 from __future__ import annotations
@@ -185,14 +193,31 @@ def near_doubt(cyc: Cycles, law_fit: PhaseFit, rate: bool, prior: float, second:
     data = _Near.of(cyc, law_fit, rate, prior, subtracted)
     if data is None or abs(second.omega / law_fit.omega0 - 1.0) > NEAR_BAND:
         return 0.0
-    base = data.fit(_ENVELOPE_TWO)
-    c = complex(second.c, -second.s) * np.exp((-second.decay + 1j * second.omega) * data.middle)
-    two = data.fit(_ENVELOPE_TWO, np.concatenate([base.x, [second.omega, second.decay, c.real, c.imag]]))
+    two = data.from_second(second)
     scale = max(2.0 * two.cost / data.dof(two), 1.0)
     jac = two.jac
     free = np.linalg.pinv(jac.T @ jac)[1, 1]
     held = np.linalg.pinv(jac[:, :-4].T @ jac[:, :-4])[1, 1]
     return scale * max(free - held, 0.0)
+
+
+def near_refit(cyc: Cycles, law_fit: PhaseFit, rate: bool, prior: float, second: Second) -> Second:
+    """A second mode the periodogram found (:func:`.second_mode.second_mode_of`: apart from the band
+    the first mode swept, but within :data:`NEAR_BAND` of its frequency), refitted beside the first
+    mode in the cycles' two-mode model of :func:`near_mode_of`: the periodogram's fit takes the first
+    mode as the law fitted it, and that law has taken part of the beat. ``second`` was subtracted from
+    the record the cycles were measured on (put back here). ``second`` itself where the cycles are too
+    few or the refitted mode is past :data:`_NEAR_SHARE` of the first or below :data:`NEAR_FLOOR`."""
+    data = _Near.of(cyc, law_fit, rate, prior, second)
+    if data is None:
+        return second
+    two = data.from_second(second)
+    first = math.exp(float(np.polynomial.chebyshev.chebval(0.0, two.x[2:3 + _ENVELOPE_TWO])))
+    omega2, decay, c = float(two.x[-4]), float(two.x[-3]), complex(two.x[-2], two.x[-1])
+    if not NEAR_FLOOR * first <= abs(c) <= _NEAR_SHARE * first or abs(omega2 / two.x[1] - 1.0) > NEAR_BAND:
+        return second
+    c = c * np.exp((decay - 1j * omega2) * data.middle)  # the amplitude at tau = 0
+    return Second(omega2, decay, float(c.real), float(-c.imag), near=True)
 
 
 class _Near:
@@ -274,6 +299,12 @@ class _Near:
             lo[-3], hi[-3] = 0.0, SECOND_DECAY_SPANS / (2.0 * self.half)
         start = np.clip(start, lo, hi)
         return least_squares(self.residual, start, args=(degree, second), bounds=(lo, hi), x_scale="jac")
+
+    def from_second(self, second: Second):
+        """The two-mode fit started from the one-mode fit and ``second`` (its amplitude at tau = 0)."""
+        base = self.fit(_ENVELOPE_TWO)
+        c = complex(second.c, -second.s) * np.exp((-second.decay + 1j * second.omega) * self.middle)
+        return self.fit(_ENVELOPE_TWO, np.concatenate([base.x, [second.omega, second.decay, c.real, c.imag]]))
 
     def starts(self, base) -> list[np.ndarray]:
         """Two-mode starts from the one-mode fit ``base``: the three highest peaks, a resolution apart,
