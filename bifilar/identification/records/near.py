@@ -173,13 +173,7 @@ def near_mode_of(cyc: Cycles, law_fit: PhaseFit, rate: bool, prior: float) -> Se
     if two is None:
         return None
     gain = (one.cost - two.cost) / max(two.cost / data.dof(two), 1e-300)
-    first = math.exp(float(np.polynomial.chebyshev.chebval(0.0, two.x[2:3 + _ENVELOPE_TWO])))  # in the middle
-    omega2, decay, c = float(two.x[-4]), float(two.x[-3]), complex(two.x[-2], two.x[-1])
-    if (gain < NEAR_GAIN or not NEAR_FLOOR * first <= abs(c) <= _NEAR_SHARE * first
-            or abs(omega2 / two.x[1] - 1.0) > NEAR_BAND):
-        return None
-    c = c * np.exp((decay - 1j * omega2) * data.middle)  # the amplitude at tau = 0
-    return Second(omega2, decay, float(c.real), float(-c.imag), near=True)
+    return data.mode_of(two) if gain >= NEAR_GAIN else None
 
 
 def near_doubt(cyc: Cycles, law_fit: PhaseFit, rate: bool, prior: float, second: Second,
@@ -213,13 +207,7 @@ def near_refit(cyc: Cycles, law_fit: PhaseFit, rate: bool, prior: float, second:
     data = _Near.of(cyc, law_fit, rate, prior, second)
     if data is None:
         return second
-    two = data.from_second(second)
-    first = math.exp(float(np.polynomial.chebyshev.chebval(0.0, two.x[2:3 + _ENVELOPE_TWO])))
-    omega2, decay, c = float(two.x[-4]), float(two.x[-3]), complex(two.x[-2], two.x[-1])
-    if not NEAR_FLOOR * first <= abs(c) <= _NEAR_SHARE * first or abs(omega2 / two.x[1] - 1.0) > NEAR_BAND:
-        return second
-    c = c * np.exp((decay - 1j * omega2) * data.middle)  # the amplitude at tau = 0
-    return Second(omega2, decay, float(c.real), float(-c.imag), near=True)
+    return data.mode_of(data.from_second(second)) or second
 
 
 class _Near:
@@ -315,6 +303,17 @@ class _Near:
         start = np.clip(start, lo, hi)
         return least_squares(self.residual, start, args=(degree, second), bounds=(lo, hi), x_scale="jac", ftol=1e-6,
                              xtol=1e-6)
+
+    def mode_of(self, two) -> Second | None:
+        """The near mode of the two-mode fit ``two`` (its amplitude at tau = 0), None where it is past
+        :data:`_NEAR_SHARE` of the first mode's swing in the record's middle, below :data:`NEAR_FLOOR` of
+        it, or outside :data:`NEAR_BAND`."""
+        first = math.exp(float(np.polynomial.chebyshev.chebval(0.0, two.x[2:3 + _ENVELOPE_TWO])))
+        omega2, decay, c = float(two.x[-4]), float(two.x[-3]), complex(two.x[-2], two.x[-1])
+        if not NEAR_FLOOR * first <= abs(c) <= _NEAR_SHARE * first or abs(omega2 / two.x[1] - 1.0) > NEAR_BAND:
+            return None
+        c = c * np.exp((decay - 1j * omega2) * self.middle)
+        return Second(omega2, decay, float(c.real), float(-c.imag), near=True)
 
     def from_second(self, second: Second):
         """The two-mode fit started from the one-mode fit and ``second`` (its amplitude at tau = 0)."""
