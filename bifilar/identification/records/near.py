@@ -316,29 +316,36 @@ class _Near:
         return Second(omega2, decay, float(c.real), float(-c.imag), near=True)
 
     def from_second(self, second: Second):
-        """The two-mode fit started from the one-mode fit and ``second`` (its amplitude at tau = 0)."""
+        """The best two-mode fit started from the one-mode fit and ``second`` (its amplitude at tau = 0)
+        or from its mirror image about the first mode's frequency, 2 omega0 - omega2, sized by the
+        projection there (where the law took the beat's phase, what is left of it is the envelope's
+        wobble, whose two sidebands are alike: a periodogram may pick either)."""
         base = self.fit(_ENVELOPE_TWO)
         c = complex(second.c, -second.s) * np.exp((-second.decay + 1j * second.omega) * self.middle)
-        return self.fit(_ENVELOPE_TWO, np.concatenate([base.x, [second.omega, second.decay, c.real, c.imag]]))
+        starts = [np.concatenate([base.x, [second.omega, second.decay, c.real, c.imag]])]
+        starts += self.starts(base, [2.0 * base.x[1] - second.omega])
+        return min((self.fit(_ENVELOPE_TWO, start) for start in starts), key=lambda sol: sol.cost)
 
-    def starts(self, base) -> list[np.ndarray]:
-        """Two-mode starts from the one-mode fit ``base``: the three highest peaks, a resolution apart,
-        of the periodogram of what it leaves (z / z1 - 1) |z1| over omega2 within NEAR_BAND."""
+    def starts(self, base, picked: list[float] | None = None) -> list[np.ndarray]:
+        """Two-mode starts from the one-mode fit ``base`` at the frequencies ``picked`` (None: the three
+        highest peaks, a resolution apart, of the periodogram of what it leaves (z / z1 - 1) |z1| over
+        omega2 within NEAR_BAND), each sized by the projection of that rest there."""
         p = base.x
         z1 = self.model(p, _ENVELOPE_TWO, False)
         rest = (self.z / z1 - 1.0) * np.abs(z1)
         weight = 1.0 / self.sd_phase**2
         u = self.t - self.middle
-        resolution = math.pi / self.half
-        grid = p[1] * (1.0 + np.linspace(-NEAR_BAND, NEAR_BAND, 401))
-        shifts = np.exp(-1j * np.outer(grid - p[1], u))
-        power = np.abs(shifts @ (weight * rest))
-        picked = []
-        for j in np.argsort(power)[::-1]:
-            if all(abs(grid[j] - g) > resolution for g in picked):
-                picked.append(grid[j])
-            if len(picked) == 3:
-                break
+        if picked is None:
+            resolution = math.pi / self.half
+            grid = p[1] * (1.0 + np.linspace(-NEAR_BAND, NEAR_BAND, 401))
+            shifts = np.exp(-1j * np.outer(grid - p[1], u))
+            power = np.abs(shifts @ (weight * rest))
+            picked = []
+            for j in np.argsort(power)[::-1]:
+                if all(abs(grid[j] - g) > resolution for g in picked):
+                    picked.append(grid[j])
+                if len(picked) == 3:
+                    break
         out = []
         for omega2 in picked:
             c = np.sum(weight * rest * np.exp(-1j * (omega2 - p[1]) * u)) / np.sum(weight) * np.exp(1j * p[0])
