@@ -260,32 +260,76 @@ class _Near:
     def dof(self, sol) -> int:
         return max(2 * len(self.t) + 2 - len(sol.x), 1)
 
-    def law_phase(self, omega0: float, envelope: np.ndarray, excess: np.ndarray) -> np.ndarray:
-        """int_middle^t dt / (R(A) E(A)) (s) at the cycles: the ideal law R (none where the swing in rad
-        is not known), A the first mode's own peak swing (rad: a rate's fundamental over omega0)."""
+    def law_phase(self, omega0: float, envelope: np.ndarray, excess: np.ndarray):
+        """int_middle^t dt / (R(A) E(A)) (s) at the cycles, and its derivatives by omega0, by ln A's
+        Chebyshev terms (columns) and by the excess's two terms (columns): the ideal law R (none where
+        the swing in rad is not known), A the first mode's own peak swing (rad: a rate's fundamental
+        over omega0), E = 1 + width (e1 A^2 + e2 A^4)."""
+        n, k = len(self.t), len(envelope)
         if self.table is None:
-            return self.t - self.middle
-        a = np.exp(self.basis(len(envelope) - 1)[0] @ envelope)
-        a = np.minimum(a / omega0 if self.rate else a, self.table.largest)
-        a2 = a * a
-        rate = 1.0 / (self.ratio(a2) * (1.0 + self.width * (excess[0] * a2 + excess[1] * a2 * a2)))
-        q = cumulative_trapezoid(rate, self.grid, initial=0.0)
-        return q[::_SUBSTEPS] - np.interp(self.middle, self.grid, q)
+            return self.t - self.middle, np.zeros(n), np.zeros((n, k)), np.zeros((n, 2))
+        grid_basis = self.basis(k - 1)[0]
+        a = np.exp(grid_basis @ envelope) / (omega0 if self.rate else 1.0)
+        inside = a < self.table.largest  # past it the table's last value is held: no derivative
+        a2 = np.minimum(a, self.table.largest) ** 2
+        ratio = self.ratio(a2)
+        excess_factor = 1.0 + self.width * (excess[0] * a2 + excess[1] * a2 * a2)
+        rate = 1.0 / (ratio * excess_factor)
+        # d rate / d A^2, and d A^2 / d (omega0, ln A's terms)
+        slope = np.where(inside, -rate * (self.ratio.deriv()(a2) / ratio
+                                          + self.width * (excess[0] + 2.0 * excess[1] * a2) / excess_factor), 0.0)
+        columns = np.column_stack([slope * -2.0 * a2 / omega0 if self.rate else np.zeros_like(a2),
+                                   (slope * 2.0 * a2)[:, None] * grid_basis,
+                                   -rate * self.width * a2 / excess_factor, -rate * self.width * a2 * a2 / excess_factor])
+        q = self._integral(np.column_stack([rate, columns]))
+        return q[:, 0], q[:, 1], q[:, 2:2 + k], q[:, 2 + k:]
 
-    def model(self, p: np.ndarray, degree: int, second: bool) -> np.ndarray:
-        """The complex fundamental at the cycles."""
+    def _integral(self, f: np.ndarray) -> np.ndarray:
+        """int_middle^t f dt at the cycles (trapezoid on the grid), column by column."""
+        q = cumulative_trapezoid(f, self.grid, axis=0, initial=0.0)
+        j = min(int(np.searchsorted(self.grid, self.middle)), len(self.grid) - 1)
+        j = max(j, 1)
+        w = (self.middle - self.grid[j - 1]) / max(self.grid[j] - self.grid[j - 1], 1e-300)
+        return q[::_SUBSTEPS] - (q[j - 1] + w * (q[j] - q[j - 1]))
+
+    def model(self, p: np.ndarray, degree: int, second: bool, derivatives: bool = False):
+        """The complex fundamental at the cycles (and, with ``derivatives``, its derivatives by p, columns)."""
         envelope = p[2:3 + degree]
         u = self.t - self.middle
-        log_a = self.basis(degree)[1] @ envelope
-        z = np.exp(log_a + 1j * (p[0] + p[1] * self.law_phase(p[1], envelope, p[3 + degree:5 + degree])))
+        at_cycles = self.basis(degree)[1]
+        law, by_omega, by_envelope, by_excess = self.law_phase(p[1], envelope, p[3 + degree:5 + degree])
+        z1 = np.exp(at_cycles @ envelope + 1j * (p[0] + p[1] * law))
+        z = z1
         if second:
             omega2, decay, cr, ci = p[5 + degree:9 + degree]
-            z = z + complex(cr, ci) * np.exp((-decay + 1j * omega2) * u) * np.sinc((omega2 - self.omega) / self.omega)
-        return z
+            x = (omega2 - self.omega) / self.omega
+            shape = np.exp((-decay + 1j * omega2) * u) * np.sinc(x)
+            z = z1 + complex(cr, ci) * shape
+        if not derivatives:
+            return z
+        log_z1 = np.column_stack([np.full(len(u), 1j), 1j * (law + p[1] * by_omega),
+                                  at_cycles + 1j * p[1] * by_envelope, 1j * p[1] * by_excess])
+        dz = z1[:, None] * log_z1
+        if second:
+            c = complex(cr, ci)
+            safe = np.where(x == 0.0, 1.0, x)
+            sinc_slope = np.where(x == 0.0, 0.0, (np.cos(np.pi * safe) - np.sinc(safe)) / safe)
+            ramp = np.exp((-decay + 1j * omega2) * u)
+            dz = np.column_stack([dz, c * ramp * (1j * u * np.sinc(x) + sinc_slope / self.omega), -u * c * shape,
+                                  shape, 1j * shape])
+        return z, dz
 
     def residual(self, p: np.ndarray, degree: int, second: bool) -> np.ndarray:
         q = self.z / self.model(p, degree, second)
         return np.concatenate([np.angle(q) / self.sd_phase, np.log(np.abs(q)) / self.sd_log, p[3 + degree:5 + degree]])
+
+    def jacobian(self, p: np.ndarray, degree: int, second: bool) -> np.ndarray:
+        """d residual / d p: the model's log derivative, its imaginary part the phase's, its real part ln A's."""
+        z, dz = self.model(p, degree, second, derivatives=True)
+        log_slope = dz / z[:, None]
+        prior = np.zeros((2, len(p)))
+        prior[0, 3 + degree] = prior[1, 4 + degree] = 1.0
+        return np.vstack([-log_slope.imag / self.sd_phase[:, None], -log_slope.real / self.sd_log[:, None], prior])
 
     def fit(self, degree: int, start: np.ndarray | None = None):
         """The least squares of one mode (``start`` None: from the envelope's and the phase's linear
@@ -295,14 +339,14 @@ class _Near:
             u = self.t - self.middle
             envelope = np.polynomial.chebyshev.chebfit(u / self.half, self.log_a, degree)
             w0 = np.polyfit(u, self.phase, 1)[0]
-            omega0, phi0 = np.polyfit(self.law_phase(w0, envelope, np.zeros(2)), self.phase, 1)
+            omega0, phi0 = np.polyfit(self.law_phase(w0, envelope, np.zeros(2))[0], self.phase, 1)
             start = np.concatenate([[phi0, omega0], envelope, [0.0, 0.0]])
         lo, hi = np.full(len(start), -np.inf), np.full(len(start), np.inf)
         if second:  # a mode beating in lasts the record (:func:`.second_mode.second_mode_of`)
             lo[-3], hi[-3] = 0.0, SECOND_DECAY_SPANS / (2.0 * self.half)
         start = np.clip(start, lo, hi)
-        return least_squares(self.residual, start, args=(degree, second), bounds=(lo, hi), x_scale="jac", ftol=1e-6,
-                             xtol=1e-6)
+        return least_squares(self.residual, start, jac=self.jacobian, args=(degree, second), bounds=(lo, hi),
+                             x_scale="jac", ftol=1e-6, xtol=1e-6)
 
     def mode_of(self, two) -> Second | None:
         """The near mode of the two-mode fit ``two`` (its amplitude at tau = 0), None where it is past
