@@ -17,9 +17,9 @@ to -3.8): there the envelope only falls faster, and the law learns the beat with
 Stop 49's code (the decay test, the long-run covariance) printed "rms z 1.1376161472353525"; stop 50's
 (near modes found by their beat and refitted beside the first mode: :mod:`...records.near`) prints
 "rms z 1.1470669697276947": 17 of the 30 have a second mode fitted, 15 within 6e-3 of the sway's
-frequency; one record (a sway at 0.987 omega0,
-under half a beat) is 3.8 sigma off, and the 0.3 rad records whose law conflicts (e.g. #11, a 9 % sway
-1.15 beats off) keep their flag, the two-mode fit of their cycles no better than one mode's.
+frequency; one record (a sway at 0.987 omega0, under half a beat) is 3.8 sigma off, and the 0.3 rad
+records whose law conflicts (e.g. #11, a 9 % sway 1.15 beats off) keep their flag, the two-mode fit of
+their cycles no better than one mode's.
 """
 
 import math
