@@ -159,8 +159,7 @@ def near_mode_of(cyc: Cycles, law_fit: PhaseFit, rate: bool, prior: float) -> Se
     noise: the search over omega2 looks in many places), and the near mode is at most
     :data:`_NEAR_SHARE` of the first, at least :data:`NEAR_FLOOR` of it (below, the first mode's own
     law misfit: a noiseless 100-cycle record's fitted as a mode of 1.1e-4 at 1.058 T0), and lasts the
-    record. The residuals are each cycle's phase and
-    ln a, over their sigmas."""
+    record. The residuals are each cycle's phase and ln a, over their sigmas."""
     data = _Near.of(cyc, law_fit, rate, prior)
     if data is None:
         return None
@@ -183,9 +182,9 @@ def near_doubt(cyc: Cycles, law_fit: PhaseFit, rate: bool, prior: float, second:
     (module docstring), so the law the record learns and the mode fitted beside it share what the
     record says of them, which the law's fit, the mode held, does not see. The cycles' two-mode model
     of :func:`near_mode_of` is fitted from ``second``, the cycles measured with ``subtracted`` taken
-    from the record (put back here); the difference of omega0's variance with
-    the mode free and held, both scaled by that fit's chi^2 / dof where above 1, is the doubt. 0 where the
-    mode lies outside the band or the cycles are too few."""
+    from the record (put back here); the difference of omega0's variance with the mode free and held,
+    both scaled by that fit's chi^2 / dof where above 1, is the doubt. 0 where the mode lies outside the
+    band or the cycles are too few."""
     data = _Near.of(cyc, law_fit, rate, prior, subtracted)
     if data is None or abs(second.omega / law_fit.omega0 - 1.0) > NEAR_BAND:
         return 0.0
