@@ -217,7 +217,6 @@ def fit_oscillation(t, y, kind: str, law: AmplitudeLaw = LINEAR, *, excess_prior
         near = near_mode_of(cyc, phase, rec.kind == "rate", model.prior)
     elif second is not None and abs(second.omega / phase.omega0 - 1.0) <= NEAR_BAND:
         near = near_refit(cyc, phase, rec.kind == "rate", model.prior, second)
-        near = near if near.near else None
     if near is not None:  # a mode near the torsion's frequency, found by its beat: subtracted, the law refitted
         second = near
         for _ in range(2):
@@ -225,7 +224,9 @@ def fit_oscillation(t, y, kind: str, law: AmplitudeLaw = LINEAR, *, excess_prior
             phase = model.fit(cyc, phase)
         phase = model.check_law(model.fit(cyc, phase, slips=True), cyc)
     whole = fit_whole(rec, cyc, phase, baseline, second)
-    doubt = 0.0 if whole.second is None else near_doubt(cyc, phase, rec.kind == "rate", model.prior, whole.second, second)
+    doubt = 0.0
+    if whole.second is not None:  # what a mode near the torsion's frequency trades with the law (.near)
+        doubt = near_doubt(cyc, phase, rec.kind == "rate", model.prior, whole.second, second)
     return _result(rec, t, cyc, model, phase, baseline, whole, rejected, law.kind, doubt)
 
 
@@ -252,7 +253,7 @@ def _check_swing(cyc: Cycles, law: AmplitudeLaw, kind: str) -> None:
 
 
 def _result(rec: Samples, t: np.ndarray, cyc: Cycles, model: Model, phase: PhaseFit, baseline: np.ndarray,
-            whole: Whole, rejected: Rejected, ideal_kind: str = "linear", near: float = 0.0) -> OscillationFit:
+            whole: Whole, rejected: Rejected, ideal_kind: str = "linear", near_variance: float = 0.0) -> OscillationFit:
     good = cyc.good & np.isfinite(cyc.phase)
     omega0 = whole.omega0
     period = 2.0 * math.pi / omega0
@@ -278,8 +279,8 @@ def _result(rec: Samples, t: np.ndarray, cyc: Cycles, model: Model, phase: Phase
         std_stat = max(std_stat, to_period * math.sqrt(jack / ratio * few_blocks(groups)))
     # what choosing the envelope's degree adds, which neither holds (the jackknife keeps the degree)
     std_stat = math.hypot(std_stat, to_period * math.sqrt(model.envelope_doubt(phase, cyc)))
-    # and what a mode near the torsion's frequency adds by trading with the law (``near``: .near.near_doubt)
-    std_stat = math.hypot(std_stat, to_period * math.sqrt(near))
+    # and what a mode near the torsion's frequency adds by trading with the law (.near.near_doubt)
+    std_stat = math.hypot(std_stat, to_period * math.sqrt(near_variance))
     std_white = to_period * math.sqrt(whole.variance_white)
     second = whole.second
     fitted = np.full(len(t), np.nan)

@@ -185,8 +185,10 @@ def near_doubt(cyc: Cycles, law_fit: PhaseFit, rate: bool, prior: float, second:
     from the record (put back here); the difference of omega0's variance with the mode free and held,
     both scaled by that fit's chi^2 / dof where above 1, is the doubt. 0 where the mode lies outside the
     band or the cycles are too few."""
+    if abs(second.omega / law_fit.omega0 - 1.0) > NEAR_BAND:
+        return 0.0
     data = _Near.of(cyc, law_fit, rate, prior, subtracted)
-    if data is None or abs(second.omega / law_fit.omega0 - 1.0) > NEAR_BAND:
+    if data is None:
         return 0.0
     two = data.from_second(second)
     scale = max(2.0 * two.cost / data.dof(two), 1.0)
@@ -196,17 +198,16 @@ def near_doubt(cyc: Cycles, law_fit: PhaseFit, rate: bool, prior: float, second:
     return scale * max(free - held, 0.0)
 
 
-def near_refit(cyc: Cycles, law_fit: PhaseFit, rate: bool, prior: float, second: Second) -> Second:
+def near_refit(cyc: Cycles, law_fit: PhaseFit, rate: bool, prior: float, second: Second) -> Second | None:
     """A second mode the periodogram found (:func:`.second_mode.second_mode_of`: apart from the band
     the first mode swept, but within :data:`NEAR_BAND` of its frequency), refitted beside the first
     mode in the cycles' two-mode model of :func:`near_mode_of`: the periodogram's fit takes the first
     mode as the law fitted it, and that law has taken part of the beat. ``second`` was subtracted from
-    the record the cycles were measured on (put back here). ``second`` itself where the cycles are too
-    few or the refitted mode is past :data:`_NEAR_SHARE` of the first or below :data:`NEAR_FLOOR`."""
+    the record the cycles were measured on (put back here). None where the cycles are too few or the
+    refitted mode is past :data:`_NEAR_SHARE` of the first or below :data:`NEAR_FLOOR` (``second``
+    stays as the periodogram fitted it)."""
     data = _Near.of(cyc, law_fit, rate, prior, second)
-    if data is None:
-        return second
-    return data.mode_of(data.from_second(second)) or second
+    return None if data is None else data.mode_of(data.from_second(second))
 
 
 class _Near:
@@ -224,15 +225,14 @@ class _Near:
         t, omega = cyc.centre[good], cyc.omega[good]
         z = cyc.fundamental[good] * np.exp(1j * cyc.phase[good])
         if add is not None:
-            z = z + complex(add.c, -add.s) * np.exp((-add.decay + 1j * add.omega) * t) * np.sinc((add.omega - omega) / omega)
+            z = z + add.phasor(t) * np.sinc((add.omega - omega) / omega)
         law_phase = law_fit.phase_at(t)
         phase = law_phase + np.angle(z * np.exp(-1j * law_phase))
         # the ideal law's table, where the swing in rad is known; its excess E = 1 + width (e1 A^2 + e2 A^4)
-        lawful = law_fit.table is not None and law_fit.ideal is not None and law_fit.scale_known and prior > 0.0
-        width = prior * abs(law_fit.ideal) if lawful else 0.0
+        table = law_fit.table if law_fit.scale_known else None
+        width = prior * abs(law_fit.ideal) if table is not None and law_fit.ideal is not None else 0.0
         return cls(t, phase, np.abs(z), np.sqrt(cyc.phase_var[good]),
-                   np.sqrt(cyc.amplitude_var[good]) / cyc.fundamental[good], omega,
-                   law_fit.table if law_fit.table is not None and law_fit.scale_known else None, width, rate)
+                   np.sqrt(cyc.amplitude_var[good]) / cyc.fundamental[good], omega, table, width, rate)
 
     def __init__(self, t, phase, amplitude, sd_phase, sd_log, omega, table, width, rate):
         self.t, self.phase, self.sd_phase, self.sd_log, self.omega = t, phase, sd_phase, sd_log, omega
@@ -243,6 +243,7 @@ class _Near:
             # evaluation at every step of every fit cost 3x the rest of the model (within 1e-10 of R to 1.2 rad)
             a2 = np.linspace(0.0, table.largest, 64) ** 2
             self.ratio = np.polynomial.Polynomial.fit(a2, table.ratio_at(np.sqrt(a2)), _RATIO_DEGREE)
+            self.ratio_slope = self.ratio.deriv()
         self.middle = 0.5 * (t[0] + t[-1])
         self.half = max(0.5 * (t[-1] - t[0]), 1e-300)
         # the law's phase integral, trapezoid, over _SUBSTEPS steps between neighbouring cycles
@@ -275,11 +276,12 @@ class _Near:
         excess_factor = 1.0 + self.width * (excess[0] * a2 + excess[1] * a2 * a2)
         rate = 1.0 / (ratio * excess_factor)
         # d rate / d A^2, and d A^2 / d (omega0, ln A's terms)
-        slope = np.where(inside, -rate * (self.ratio.deriv()(a2) / ratio
+        slope = np.where(inside, -rate * (self.ratio_slope(a2) / ratio
                                           + self.width * (excess[0] + 2.0 * excess[1] * a2) / excess_factor), 0.0)
         columns = np.column_stack([slope * -2.0 * a2 / omega0 if self.rate else np.zeros_like(a2),
                                    (slope * 2.0 * a2)[:, None] * grid_basis,
-                                   -rate * self.width * a2 / excess_factor, -rate * self.width * a2 * a2 / excess_factor])
+                                   -rate * self.width * a2 / excess_factor,
+                                   -rate * self.width * a2 * a2 / excess_factor])
         q = self._integral(np.column_stack([rate, columns]))
         return q[:, 0], q[:, 1], q[:, 2:2 + k], q[:, 2 + k:]
 
@@ -364,7 +366,7 @@ class _Near:
         projection there (where the law took the beat's phase, what is left of it is the envelope's
         wobble, whose two sidebands are alike: a periodogram may pick either)."""
         base = self.fit(_ENVELOPE_TWO)
-        c = complex(second.c, -second.s) * np.exp((-second.decay + 1j * second.omega) * self.middle)
+        c = second.phasor(self.middle)
         starts = [np.concatenate([base.x, [second.omega, second.decay, c.real, c.imag]])]
         starts += self.starts(base, [2.0 * base.x[1] - second.omega])
         return min((self.fit(_ENVELOPE_TWO, start) for start in starts), key=lambda sol: sol.cost)

@@ -90,6 +90,11 @@ class Second:
     def signal(self, tau):
         return np.exp(-self.decay * tau) * (self.c * np.cos(self.omega * tau) + self.s * np.sin(self.omega * tau))
 
+    def phasor(self, tau):
+        """The complex amplitude at ``tau`` whose real part times e^(i omega u) is the signal at tau + u
+        (u small): (c - i s) e^((-decay + i omega) tau), what a window centred at tau fits as its fundamental."""
+        return complex(self.c, -self.s) * np.exp((-self.decay + 1j * self.omega) * tau)
+
 
 def _in_phase_harmonics(cyc: Cycles, good: np.ndarray) -> dict[int, np.ndarray]:
     """{n: the n-th odd harmonic's amplitude in each good cycle} (signal units), 1 the fundamental: each
