@@ -207,7 +207,7 @@ def near_refit(cyc: Cycles, law_fit: PhaseFit, rate: bool, prior: float, second:
     refitted mode is past :data:`_NEAR_SHARE` of the first or below :data:`NEAR_FLOOR` (``second``
     stays as the periodogram fitted it)."""
     data = _Near.of(cyc, law_fit, rate, prior, second)
-    return None if data is None else data.mode_of(data.from_second(second))
+    return None if data is None else data.mode_of(data.from_second(second, mirror=True))
 
 
 class _Near:
@@ -360,15 +360,16 @@ class _Near:
         c = c * np.exp((decay - 1j * omega2) * self.middle)
         return Second(omega2, decay, float(c.real), float(-c.imag), near=True)
 
-    def from_second(self, second: Second):
-        """The best two-mode fit started from the one-mode fit and ``second`` (its amplitude at tau = 0)
-        or from its mirror image about the first mode's frequency, 2 omega0 - omega2, sized by the
-        projection there (where the law took the beat's phase, what is left of it is the envelope's
-        wobble, whose two sidebands are alike: a periodogram may pick either)."""
+    def from_second(self, second: Second, mirror: bool = False):
+        """The two-mode fit started from the one-mode fit and ``second``; with ``mirror``, the better of
+        that and one started from its mirror image about the first mode's frequency, 2 omega0 - omega2,
+        sized by the projection there (where the law took the beat's phase, what is left of it is the
+        envelope's wobble, whose two sidebands are alike: a periodogram may pick either)."""
         base = self.fit(_ENVELOPE_TWO)
         c = second.phasor(self.middle)
         starts = [np.concatenate([base.x, [second.omega, second.decay, c.real, c.imag]])]
-        starts += self.starts(base, [2.0 * base.x[1] - second.omega])
+        if mirror:
+            starts += self.starts(base, [2.0 * base.x[1] - second.omega])
         return min((self.fit(_ENVELOPE_TWO, start) for start in starts), key=lambda sol: sol.cost)
 
     def starts(self, base, picked: list[float] | None = None) -> list[np.ndarray]:
