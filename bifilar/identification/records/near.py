@@ -260,14 +260,15 @@ class _Near:
     def dof(self, sol) -> int:
         return max(2 * len(self.t) + 2 - len(sol.x), 1)
 
-    def law_phase(self, omega0: float, envelope: np.ndarray, excess: np.ndarray):
-        """int_middle^t dt / (R(A) E(A)) (s) at the cycles, and its derivatives by omega0, by ln A's
-        Chebyshev terms (columns) and by the excess's two terms (columns): the ideal law R (none where
-        the swing in rad is not known), A the first mode's own peak swing (rad: a rate's fundamental
-        over omega0), E = 1 + width (e1 A^2 + e2 A^4)."""
+    def law_phase(self, omega0: float, envelope: np.ndarray, excess: np.ndarray, derivatives: bool = False):
+        """int_middle^t dt / (R(A) E(A)) (s) at the cycles, and with ``derivatives`` its derivatives by
+        omega0, by ln A's Chebyshev terms (columns) and by the excess's two terms (columns): the ideal
+        law R (none where the swing in rad is not known), A the first mode's own peak swing (rad: a
+        rate's fundamental over omega0), E = 1 + width (e1 A^2 + e2 A^4)."""
         n, k = len(self.t), len(envelope)
         if self.table is None:
-            return self.t - self.middle, np.zeros(n), np.zeros((n, k)), np.zeros((n, 2))
+            law = self.t - self.middle
+            return (law, np.zeros(n), np.zeros((n, k)), np.zeros((n, 2))) if derivatives else law
         grid_basis = self.basis(k - 1)[0]
         a = np.exp(grid_basis @ envelope) / (omega0 if self.rate else 1.0)
         inside = a < self.table.largest  # past it the table's last value is held: no derivative
@@ -275,6 +276,8 @@ class _Near:
         ratio = self.ratio(a2)
         excess_factor = 1.0 + self.width * (excess[0] * a2 + excess[1] * a2 * a2)
         rate = 1.0 / (ratio * excess_factor)
+        if not derivatives:
+            return self._integral(rate)
         # d rate / d A^2, and d A^2 / d (omega0, ln A's terms)
         slope = np.where(inside, -rate * (self.ratio_slope(a2) / ratio
                                           + self.width * (excess[0] + 2.0 * excess[1] * a2) / excess_factor), 0.0)
@@ -298,13 +301,15 @@ class _Near:
         envelope = p[2:3 + degree]
         u = self.t - self.middle
         at_cycles = self.basis(degree)[1]
-        law, by_omega, by_envelope, by_excess = self.law_phase(p[1], envelope, p[3 + degree:5 + degree])
+        law = self.law_phase(p[1], envelope, p[3 + degree:5 + degree], derivatives)
+        law, by_omega, by_envelope, by_excess = law if derivatives else (law, None, None, None)
         z1 = np.exp(at_cycles @ envelope + 1j * (p[0] + p[1] * law))
         z = z1
         if second:
             omega2, decay, cr, ci = p[5 + degree:9 + degree]
             x = (omega2 - self.omega) / self.omega
-            shape = np.exp((-decay + 1j * omega2) * u) * np.sinc(x)
+            ramp = np.exp((-decay + 1j * omega2) * u)
+            shape = ramp * np.sinc(x)
             z = z1 + complex(cr, ci) * shape
         if not derivatives:
             return z
@@ -315,7 +320,6 @@ class _Near:
             c = complex(cr, ci)
             safe = np.where(x == 0.0, 1.0, x)
             sinc_slope = np.where(x == 0.0, 0.0, (np.cos(np.pi * safe) - np.sinc(safe)) / safe)
-            ramp = np.exp((-decay + 1j * omega2) * u)
             dz = np.column_stack([dz, c * ramp * (1j * u * np.sinc(x) + sinc_slope / self.omega), -u * c * shape,
                                   shape, 1j * shape])
         return z, dz
@@ -340,7 +344,7 @@ class _Near:
             u = self.t - self.middle
             envelope = np.polynomial.chebyshev.chebfit(u / self.half, self.log_a, degree)
             w0 = np.polyfit(u, self.phase, 1)[0]
-            omega0, phi0 = np.polyfit(self.law_phase(w0, envelope, np.zeros(2))[0], self.phase, 1)
+            omega0, phi0 = np.polyfit(self.law_phase(w0, envelope, np.zeros(2)), self.phase, 1)
             start = np.concatenate([[phi0, omega0], envelope, [0.0, 0.0]])
         lo, hi = np.full(len(start), -np.inf), np.full(len(start), np.inf)
         if second:  # a mode beating in lasts the record (:func:`.second_mode.second_mode_of`)
