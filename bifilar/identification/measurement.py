@@ -30,7 +30,7 @@ from bifilar.rig import Rig, RigError
 from .air import added_moment, still, with_air
 from .identify import axis_vector, identify, invert_period, pencil, with_moment
 from .propagation import budget, linear_axes, monte_carlo, period_only
-from .records.pipeline import Pooled, RecordOptions, Trial, identify_records
+from .records.pipeline import Pooled, RecordOptions, Trial, beats, identify_records
 from .transfer import object_part, parallel_axis_moment
 
 AXIS_INDEX = {"x": 0, "y": 1, "z": 2}
@@ -393,6 +393,7 @@ def trial_dict(tr: Trial, mass: float) -> dict:
         "residual_rms": fit.rms,
         "outliers": fit.outliers.tolist(),
         "second_mode": None if fit.second_mode is None else dict(zip(("period", "amplitude", "decay"), fit.second_mode)),
+        "near_modes": [{"period": t2, "beats": beats(tr.record, fit, t2)} for t2 in tr.near],
         "samples": fit.samples,
         "binned": fit.binned,
         "cycles": fit.cycles,

@@ -12,7 +12,10 @@
    (:mod:`.units`);
 4. for a mode that is not a symmetric torsion, the law is the Kane model's series at the identified
    moment with its quintic matched at the record's amplitude: refit once if it moved;
-5. invert the zero-amplitude period into the moment (:func:`bifilar.identification.identify.invert_period`);
+5. invert the zero-amplitude period into the moment (:func:`bifilar.identification.identify.invert_period`),
+   and list the rig's other modes within :data:`.near.NEAR_BAND` of the timed one's frequency there
+   (:func:`near_modes`): a sway of one of them that beats less than :data:`NEAR_BEATS` times over the
+   record is, in one record, taken by the amplitude law (:mod:`.near`), so the record is flagged;
 6. fit each half of the record alone: their agreement is the record's own test of its sigma (``halves``);
 7. pool the trials (:func:`pool`): the records of one rig share its amplitude law, so the part of each
    sigma that is the law's prior is common to all of them (a full covariance, not independent noise).
@@ -52,12 +55,15 @@ from bifilar.rig import Rig, RigError
 from .bounds import Deadline, LawBandError, WorkSpent
 from .fit import OscillationFit, SwingError, fit_oscillation
 from .law import EXCESS_PRIOR, AmplitudeLaw
+from .near import NEAR_BAND
 from .read import Record, read_record
 from .units import degrees_read_as_rad
 
 CONSISTENCY = 0.99  # chi^2 quantile above which the trials are called inconsistent
 HALVES_Z = 3.0  # halves further apart than this many sigmas: flagged
 SUSPECT_TORSION = 0.5 * math.pi  # a torsion beyond this is rare enough to say so (rad)
+NEAR_BEATS = 1.5  # a near mode beating fewer times than this over a record may hide in its law (.near;
+# identify-record-near-mode: sways of 1.2 beats and more were fitted or flagged, of 0.28 and 0.87 not)
 _DEGREE = math.pi / 180.0
 # Below this amplitude (rad) the series law's O(A^4) error, ~s^2 A^4, is under 1e-6: no quintic.
 _MATCH_FROM = 0.1
@@ -109,6 +115,7 @@ class Trial:
     moment_std: float
     sensitivity: float
     flags: tuple[str, ...]  # each "<record file name>: <what>"
+    near: tuple[float, ...] = ()  # s, the rig's other modes near the timed one (:func:`near_modes`)
 
     @property
     def said(self) -> list[tuple[str, str]]:
@@ -133,10 +140,12 @@ class Pooled:
 @dataclass(frozen=True)
 class Inverted:
     """A period inverted: the quantity identified (a moment, kg m^2; a rod's stiffness, N m/rad) and
-    d ln T / d ln(quantity) (its sign kept)."""
+    d ln T / d ln(quantity) (its sign kept); ``near``: the periods (s) of the rig's other modes within
+    :data:`.near.NEAR_BAND` of the timed one's frequency there (:func:`near_modes`)."""
 
     value: float
     sensitivity: float
+    near: tuple[float, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -158,9 +167,21 @@ def wire_target(rig: Rig, axis, p: Pencil) -> Target:
 
     def invert(period: float) -> Inverted:
         found = invert_period(rig, axis, period, p=p)
-        return Inverted(found.moment, found.sensitivity)
+        return Inverted(found.moment, found.sensitivity, near_modes(p, found.moment))
 
     return Target(ideal, lambda fit: _law_at(rig, axis, fit, ideal, p), invert)
+
+
+def near_modes(p: Pencil, value: float) -> tuple[float, ...]:
+    """The periods (s) of the rig's oscillating modes, other than the one timed about the pencil's
+    axis, whose frequency is within :data:`.near.NEAR_BAND` of that one's at moment ``value``: a
+    bifilar's sway where the body's radius of gyration nears half the wires' spacing, or a roll the
+    moment tunes the yaw onto. A real rig couples such a sway into the record even where the model's
+    symmetry does not (its share about the axis 0): it beats with the timed mode."""
+    k, w2, _ = p.associated(value)
+    ratio = np.sqrt(w2 / w2[k])
+    return tuple(float(2.0 * math.pi / math.sqrt(w2[j])) for j in range(len(w2))
+                 if j != k and abs(ratio[j] - 1.0) <= NEAR_BAND)
 
 
 def identify_records(rig, axis, paths: list, options: RecordOptions = RecordOptions(),
@@ -194,7 +215,8 @@ def _trial(record: Record, target: Target, options: RecordOptions, deadline: Dea
     found = _invert(target, fit, record)
     split = halves(record, law, options, deadline)
     std = abs(found.value * fit.period_std / fit.period / found.sensitivity)
-    return Trial(record, fit, split, found.value, std, found.sensitivity, tuple(_flags(record, fit, split, options)))
+    flags = _flags(record, fit, split, options) + _near_flags(record, fit, found.near)
+    return Trial(record, fit, split, found.value, std, found.sensitivity, tuple(flags), found.near)
 
 
 def _fit(record: Record, law: AmplitudeLaw, options: RecordOptions, deadline: Deadline | None = None) -> OscillationFit:
@@ -371,6 +393,29 @@ def _flags(record: Record, fit: OscillationFit, halves: Halves | None, options: 
     if fit.period_std > 0.01 * fit.period:
         flags.append(f"{name}: T0 is known to {100.0 * fit.period_std / fit.period:.2g} % only")
     return flags
+
+
+def beats(record: Record, fit: OscillationFit, period: float) -> float:
+    """How many times a mode of ``period`` (s) beats with the one fitted over the record's span."""
+    return float(record.t[-1] - record.t[0]) * abs(1.0 / period - 1.0 / fit.period)
+
+
+def _near_flags(record: Record, fit: OscillationFit, near: tuple[float, ...]) -> list[str]:
+    """A flag naming the rig's modes near the one timed (:func:`near_modes`) that beat fewer than
+    :data:`NEAR_BEATS` times over the record, where the fit kept no mode near the torsion's frequency
+    (one it kept, its trade with the law is in the sigma: :func:`.near.near_doubt`)."""
+    second = fit.second_mode
+    if second is not None and abs(fit.period / second[0] - 1.0) <= NEAR_BAND:
+        return []
+    slow = [(t2, n) for t2 in near if (n := beats(record, fit, t2)) < NEAR_BEATS]
+    if not slow:
+        return []
+    modes = " and ".join(f"{t2:.4g} s ({100.0 * abs(fit.period / t2 - 1.0):.2g} % off the timed one's frequency, "
+                         f"{n:.2g} beats over the record)" for t2, n in slow)
+    return [f"{file_name(record)}: the rig has {'a mode' if len(slow) == 1 else 'modes'} at {modes}: a sway beating "
+            "less than about once over a record is taken by the amplitude law, and T0's sigma may not hold it; pool "
+            "repeated trials (their laws' spread enters the sigma), time longer records, or part the modes (the wires "
+            "further apart or closer together)"]
 
 
 def pool(trials: list[Trial]) -> Pooled:
