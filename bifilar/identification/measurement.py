@@ -380,6 +380,7 @@ def trial_dict(tr: Trial, mass: float) -> dict:
         "crb": fit.crb,
         "crb_noise": fit.crb_noise,
         "crb_ratio": fit.period_std_statistical / fit.crb if fit.crb > 0.0 else None,
+        "period_std_parts": dict(fit.period_std_parts),
         "inertia": tr.moment,
         "std": tr.moment_std,
         "interval95": [tr.moment - Z95 * tr.moment_std, tr.moment + Z95 * tr.moment_std],

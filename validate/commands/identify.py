@@ -277,6 +277,19 @@ def _print(result: Measurement, label: str | None = None) -> None:
         say(f"warning: {flag}")
 
 
+SIGMA_PARTS = {"noise": "the record's noise", "law": "learning the amplitude law from the record",
+               "jackknife": "the jackknife's excess over the covariance", "envelope": "choosing the envelope's degree",
+               "near_mode": "a near mode trading with the law"}
+
+
+def sigma_parts(tr: dict) -> str:
+    """What makes the record's T0 variance (``period_std_parts``), largest first, each 1 % or more."""
+    total = tr["period_std_statistical"] ** 2
+    shares = sorted(((std**2 / total, name) for name, std in tr["period_std_parts"].items()), reverse=True)
+    said = [f"{SIGMA_PARTS[name]} {100.0 * share:.0f} %" for share, name in shares if share >= 0.01]
+    return f"; its variance: {', '.join(said)}" if said else ""
+
+
 def print_trial(i: int, tr: dict, key: str = "inertia", symbol: str = "I", unit: str = "kg m^2") -> None:
     """A trial in one line each: its result (``tr[key]``, printed as ``symbol`` in ``unit``), swing and
     damping, amplitude law, halves, what was left out."""
@@ -285,7 +298,7 @@ def print_trial(i: int, tr: dict, key: str = "inertia", symbol: str = "I", unit:
         f"+- {tr['std']:.3g} {unit}")
     if tr["crb_ratio"] is not None:
         say(f"T0 sigma (record) {tr['period_std_statistical']:.2g} s = {tr['crb_ratio']:.2f}x the Cramér-Rao bound "
-            f"{tr['crb']:.2g} s ({tr['crb_noise']} noise)", 4)
+            f"{tr['crb']:.2g} s ({tr['crb_noise']} noise){sigma_parts(tr)}", 4)
     amp, d = tr["amplitude"], tr["damping"]
     swing = f"{amp[0]:.3g} -> {amp[1]:.3g} rad" if amp else "in rad unknown (proportional)"
     second = tr["second_mode"]

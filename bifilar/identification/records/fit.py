@@ -67,7 +67,7 @@ cycle's third harmonic (:func:`.phase_law.harmonic_scale`) and fitted with the l
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 from scipy.stats import chi2
@@ -132,6 +132,12 @@ class OscillationFit:
     fit's model with the law's parameters free under their priors (the record's part) and the noise its
     residual shows, judged ``crb_noise`` ('white'
     or 'coloured'; :mod:`.bound`): ``period_std_statistical / crb`` is how far the fit is from efficient.
+    ``period_std_parts`` says why: the standard deviations (s) whose root-sum-square is
+    ``period_std_statistical``, each what one doubt adds (absent where it adds nothing): ``noise``, the
+    whole record's sandwich with the law held (the part the bound is of); ``law``, learning the amplitude
+    law (and a proportional record's scale) from the record; ``jackknife``, where the jackknife found the
+    covariance short; ``envelope``, choosing the envelope's degree; ``near_mode``, a mode near the
+    torsion's frequency trading with the law.
     """
 
     period: float
@@ -164,6 +170,7 @@ class OscillationFit:
     binned: int = 1  # a dense record's samples a bin (:func:`.bounds.binned`): t, y and samples are the bins'
     crb: float = math.nan  # s, the Cramér-Rao bound's sigma of T0 (:mod:`.bound`)
     crb_noise: str = ""  # the noise the bound assumed: 'white' or 'coloured'
+    period_std_parts: dict = field(default_factory=dict)  # s, what makes period_std_statistical (its docstring)
 
 
 def fit_oscillation(t, y, kind: str, law: AmplitudeLaw = LINEAR, *, excess_prior: float = EXCESS_PRIOR,
@@ -272,15 +279,19 @@ def _result(rec: Samples, t: np.ndarray, cyc: Cycles, model: Model, phase: Phase
     std_law = to_period * math.sqrt(phase.cov_law[1, 1] + held)
     std_all = to_period * math.sqrt(base + order)
     std_stat = math.sqrt(max(std_all**2 - std_law**2, to_period**2 * whole.variance))
+    parts = {"noise": to_period**2 * whole.variance}  # what each doubt adds to std_stat^2 (s^2)
+    parts["law"] = std_stat**2 - parts["noise"]
     jack, groups, ratio, dof = model.jackknife(phase, cyc)
     if not (groups and jack > (std_stat / to_period) ** 2 * ratio * chi2.ppf(0.95, dof) / dof):
         groups = 0  # the covariance holds: the jackknife is not above what it gives an honest one at 95 %
     else:  # the covariance is short: the jackknife's over its leverage, to its Student-t interval
-        std_stat = max(std_stat, to_period * math.sqrt(jack / ratio * few_blocks(groups)))
-    # what choosing the envelope's degree adds, which neither holds (the jackknife keeps the degree)
-    std_stat = math.hypot(std_stat, to_period * math.sqrt(model.envelope_doubt(phase, cyc)))
-    # and what a mode near the torsion's frequency adds by trading with the law (.near.near_doubt)
-    std_stat = math.hypot(std_stat, to_period * math.sqrt(near_variance))
+        wider = max(std_stat, to_period * math.sqrt(jack / ratio * few_blocks(groups)))
+        parts["jackknife"], std_stat = wider**2 - std_stat**2, wider
+    # what choosing the envelope's degree adds, which neither holds (the jackknife keeps the degree), and
+    # what a mode near the torsion's frequency adds by trading with the law (.near.near_doubt)
+    for name, variance in (("envelope", model.envelope_doubt(phase, cyc)), ("near_mode", near_variance)):
+        std = to_period * math.sqrt(variance)
+        parts[name], std_stat = std**2, math.hypot(std_stat, std)
     std_white = to_period * math.sqrt(whole.variance_white)
     second = whole.second
     fitted = np.full(len(t), np.nan)
@@ -358,7 +369,8 @@ def _result(rec: Samples, t: np.ndarray, cyc: Cycles, model: Model, phase: Phase
                                                  second.decay),
         block=whole.block, jackknife=groups, samples=int(kept.sum()), cycles=int(good.sum()), cycle_time=t[0] + centre,
         cycle_period=per_cycle, cycle_amplitude=cycle_amp, law_curve=curve, t=t, y=rec.y, fitted=fitted, kept=kept,
-        binned=rec.binned, crb=to_period * math.sqrt(whole.bound.variance), crb_noise=whole.bound.noise)
+        binned=rec.binned, crb=to_period * math.sqrt(whole.bound.variance), crb_noise=whole.bound.noise,
+        period_std_parts={k: math.sqrt(v) for k, v in parts.items() if v > 1e-9 * std_stat**2})  # not rounding
 
 
 def _law_curve(model: Model, phase: PhaseFit, period: float, amplitude: np.ndarray):
