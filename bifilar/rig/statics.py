@@ -374,15 +374,8 @@ def _search(rig: Rig, start: np.ndarray) -> Rest:
     if rest is None:
         # A singular equilibrium Jacobian (a COM on the line of two attachments: a neutral tilt)
         # defeats plain Newton; Levenberg-Marquardt still converges there.
-        sol = least_squares(
-            _equilibrium_residual,
-            np.concatenate([com, np.zeros(3), t0 / (rig.mass * rig.gravity)]),
-            args=(rig, rotation0, scale),
-            method="lm",
-            xtol=1e-15,
-            ftol=1e-15,
-            gtol=1e-15,
-        )
+        sol = least_squares(_equilibrium_residual, np.concatenate([com, np.zeros(3), t0 / (rig.mass * rig.gravity)]),
+                            args=(rig, rotation0, scale), method="lm", xtol=1e-15, ftol=1e-15, gtol=1e-15)
         residual = float(np.abs(sol.fun).max())
         # Dimensionless (forces / weight, lengths / rig size); 1e-16 on ordinary rigs, ~1e-9 where
         # the Jacobian is singular (a COM on CD between vertical wires: two neutral directions).
@@ -394,11 +387,8 @@ def _search(rig: Rig, start: np.ndarray) -> Rest:
     slack = np.flatnonzero(rest.tensions <= 0.0)
     if slack.size:
         i = int(slack[0])
-        raise RigError(
-            rig.source,
-            f"wire[{i + 1}]",
-            f"would be slack at rest (tension {rest.tensions[i]:.6g} N): the body cannot hang taut on every wire",
-        )
+        raise RigError(rig.source, f"wire[{i + 1}]", f"would be slack at rest (tension {rest.tensions[i]:.6g} N): "
+                       "the body cannot hang taut on every wire")
     rest = Rest(rest.com, _nearest_on_neutral_axis(rig, rest.com, rest.rotation), rest.tensions)
     if not _stable(rig, rest):
         raise RigError(rig.source, "wire", "the only equilibrium with every wire taut found is unstable: no rest pose")
