@@ -165,7 +165,7 @@ def test_the_reference_searches_derivatives_are_the_distances():
 
 
 # the ci profile draws the same rigs on every run (tests/conftest.py); a draw that finds a defect
-# becomes an @example or, until fixed, a strict xfail below
+# becomes an @example or a test of its own below (seed 837's six-wire rig)
 @pytest.mark.slow
 @settings(max_examples=20)
 @given(seed=st.integers(0, 2**32 - 1), n=st.integers(3, 6))
@@ -222,8 +222,6 @@ def test_elastic_rest_pose_is_the_lowest(seed, n):
 
 
 @pytest.mark.slow
-@pytest.mark.xfail(strict=True, reason="open defect (issue 20's class): a random six-wire rig whose lowest pose "
-                   "is taut is refused, every start ending with wire 1 slack (found by CI's draw, seed 837)")
 def test_six_wire_rig_837_hangs_at_its_lowest_taut_pose():
     data = build(837, 6, elastic=False)
     reference = independent_lowest_rigid(data, np.random.default_rng(838))

@@ -4,10 +4,9 @@ A pose is the COM position ``com`` (world frame, m) and the rotation matrix ``ro
 world frame). Both engines start from :func:`initial_state`, so that they integrate the same motion:
 
 1. the rest pose: the minimum of the potential ``m g z_com`` with every wire at its length (SLSQP from
-   the file's orientation and, for a body frame turned from the way the body hangs, from that
-   orientation too: the lowest equilibrium found), polished
-   by Newton's method on the equilibrium equations (force and moment balance, wire lengths), whose
-   unknowns include the tensions;
+   the file's orientation, the way the body hangs and more starts, a start that fails again with the
+   wires free to slacken: the lowest equilibrium found), polished by Newton's method on the equilibrium
+   equations (force and moment balance, wire lengths), whose unknowns include the tensions;
 2. the body rotated about its COM by ``rig.initial_rotation`` (rotation vector, world frame);
 3. the COM moved by the shortest displacement that makes every wire exactly its length (two wires:
    the nearest point of a circle; three: the nearer of two points; more: minimum-norm Gauss-Newton,
@@ -39,6 +38,9 @@ NULL_RTOL = 1e-9
 # the file's orientation SLSQP settled 126 deg away in a twisted equilibrium on a trifilar whose
 # hanging orientation is only 16 deg off, so any visible difference earns the second start.
 _FAR_START = np.radians(1.0)
+# A wire this fraction of the rig size short of its length is slack: on 142 random rigs of 3-6 wires SLSQP
+# ended active wires within 3e-11 of their lengths and slack ones 5e-5 or more short.
+SLACK_GAP = 1e-8
 # An omega^2 below -this fraction of the largest is a real instability, not rounding.
 NEUTRAL_SLACK = 1e-9
 
@@ -273,6 +275,7 @@ def _global_rest_pose(rig: Rig) -> Rest:
         turns = Rotation.random(MULTI_STARTS, random_state=_START_SEED).as_matrix()
         starts += [turn @ hanging for turn in turns]
     found, first_error, indeterminate, numerical = [], None, None, None
+    retry = []  # the starts whose search with every wire at its length failed
     for start in starts:
         try:
             found.append(_search(rig, start))
@@ -282,8 +285,19 @@ def _global_rest_pose(rig: Rig) -> Rest:
             first_error = first_error or exc
         except RigError as exc:
             first_error = first_error or exc
+            retry.append(start)
         except (np.linalg.LinAlgError, ValueError, FloatingPointError) as exc:  # a start gone numerically wrong
             numerical = numerical or exc
+            retry.append(start)
+    # Wires held at their lengths can leave no room to descend (six: the poses are isolated points, SLSQP
+    # only solves the length equations, to a solution near the start; issue 837: every start ended with
+    # wire 1 pushing, the lowest pose taut). From a failed start the physical problem (wires at most their
+    # lengths, tensions its multipliers, never negative) descends; the first search's reasons stand.
+    for start in retry:
+        try:
+            found.append(_search(rig, start, may_slacken=True))
+        except (RigError, np.linalg.LinAlgError, ValueError, FloatingPointError):
+            pass
     if not found:
         # Every start failed: a stated reason (a slack wire, no taut pose) if one gave it, else the
         # numerical failure itself (exit 4, as any failure inside the physics).
@@ -314,9 +328,10 @@ def _hanging_orientation(rig: Rig, with_com: bool = True) -> np.ndarray:
     return u @ np.diag([1.0, 1.0, d]) @ vt
 
 
-def _search(rig: Rig, start: np.ndarray) -> Rest:
-    """SLSQP on the potential from the body turned by ``start`` (body -> world), then :func:`_polish`
-    and the checks of :func:`rest_pose`."""
+def _search(rig: Rig, start: np.ndarray, may_slacken: bool = False) -> Rest:
+    """SLSQP on the potential from the body turned by ``start`` (body -> world), every wire at its length
+    or (``may_slacken``) at most it, refused if one ends slack; then :func:`_polish` and the checks of
+    :func:`rest_pose`."""
     scale = rig_scale(rig)
     # Start slightly turned: a symmetric start can be a stationary point that is not a minimum
     # (a body balanced upside down); the minimiser must see a gradient to roll off it.
@@ -360,10 +375,13 @@ def _search(rig: Rig, start: np.ndarray) -> Rest:
         np.concatenate([com0, np.zeros(3)]),
         jac=lambda x: height,
         method="SLSQP",
-        constraints=[{"type": "eq", "fun": wire_lengths, "jac": wire_slopes}],
+        constraints=[{"type": "ineq", "fun": lambda x: -wire_lengths(x), "jac": lambda x: -wire_slopes(x)}
+                     if may_slacken else {"type": "eq", "fun": wire_lengths, "jac": wire_slopes}],
         options={"ftol": 1e-12, "maxiter": 500},
     )
     x = coarse.x
+    if may_slacken and wire_lengths(x).min() < -SLACK_GAP:
+        raise RigError(rig.source, "wire", "a wire is slack at the lowest pose reached from this start")
     rotation0 = Rotation.from_rotvec(x[3:6]).as_matrix() @ rotation0
     com = x[:3]
     # Tension guess from force balance alone, then Newton on the full equilibrium equations.
@@ -374,15 +392,8 @@ def _search(rig: Rig, start: np.ndarray) -> Rest:
     if rest is None:
         # A singular equilibrium Jacobian (a COM on the line of two attachments: a neutral tilt)
         # defeats plain Newton; Levenberg-Marquardt still converges there.
-        sol = least_squares(
-            _equilibrium_residual,
-            np.concatenate([com, np.zeros(3), t0 / (rig.mass * rig.gravity)]),
-            args=(rig, rotation0, scale),
-            method="lm",
-            xtol=1e-15,
-            ftol=1e-15,
-            gtol=1e-15,
-        )
+        sol = least_squares(_equilibrium_residual, np.concatenate([com, np.zeros(3), t0 / (rig.mass * rig.gravity)]),
+                            args=(rig, rotation0, scale), method="lm", xtol=1e-15, ftol=1e-15, gtol=1e-15)
         residual = float(np.abs(sol.fun).max())
         # Dimensionless (forces / weight, lengths / rig size); 1e-16 on ordinary rigs, ~1e-9 where
         # the Jacobian is singular (a COM on CD between vertical wires: two neutral directions).
@@ -394,11 +405,8 @@ def _search(rig: Rig, start: np.ndarray) -> Rest:
     slack = np.flatnonzero(rest.tensions <= 0.0)
     if slack.size:
         i = int(slack[0])
-        raise RigError(
-            rig.source,
-            f"wire[{i + 1}]",
-            f"would be slack at rest (tension {rest.tensions[i]:.6g} N): the body cannot hang taut on every wire",
-        )
+        raise RigError(rig.source, f"wire[{i + 1}]", f"would be slack at rest (tension {rest.tensions[i]:.6g} N): "
+                       "the body cannot hang taut on every wire")
     rest = Rest(rest.com, _nearest_on_neutral_axis(rig, rest.com, rest.rotation), rest.tensions)
     if not _stable(rig, rest):
         raise RigError(rig.source, "wire", "the only equilibrium with every wire taut found is unstable: no rest pose")
