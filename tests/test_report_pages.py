@@ -14,6 +14,7 @@ from page_check import check_not_blank, check_self_contained, page_text, render
 from test_identify import BENCH, torsion_csv, write_rig
 
 from bifilar.identification import identify as ident
+from bifilar.identification.measurement import sigma_shares
 from bifilar.rig import load_rig
 from validate.assets import rig
 from validate.cli import main
@@ -35,6 +36,9 @@ def test_identify_page_of_two_records(tmp_path, capsys):
     assert f"I_zz {number(out['inertia'], 9)} ± {number(out['std'], 3)} kg m^2" in words
     for trial in out["trials"]:
         assert trial["source"] in words and f"{number(trial['period'], 9)} ± {number(trial['period_std'], 3)} s" in words
+        assert f"{trial['crb_ratio']:.2f}x ({trial['crb_noise']} noise)" in words  # and what makes the sigma
+        shares = sigma_shares(trial)
+        assert shares and all(f"{what} {100.0 * share:.0f} %" in words for what, share in shares)
     for group, share in out["budget"].items():
         assert f"{group} {100.0 * share:.2f} %" in words
     assert ", ".join(number(x, 6) for x in out["tensor_check"]["principal"]) in words

@@ -362,6 +362,19 @@ def said_once(said: Sequence[tuple[str, str]]) -> list[str]:
     return [f"{', '.join(names)}: {what}" for what, names in whom.items()]
 
 
+SIGMA_PARTS = {"noise": "the record's noise", "law": "learning the amplitude law from the record",
+               "jackknife": "the jackknife's excess over the covariance", "envelope": "choosing the envelope's degree",
+               "near_mode": "a near mode trading with the law"}
+
+
+def sigma_shares(trial: dict) -> list[tuple[str, float]]:
+    """What makes a trial's (:func:`trial_dict`) statistical T0 variance, from ``period_std_parts``: (what
+    in words, :data:`SIGMA_PARTS`, its share of the variance), largest first, each 1 % or more."""
+    total = trial["period_std_statistical"] ** 2
+    shares = sorted(((std**2 / total, name) for name, std in trial["period_std_parts"].items()), reverse=True)
+    return [(SIGMA_PARTS[name], share) for share, name in shares if share >= 0.01]
+
+
 def trial_dict(tr: Trial, mass: float) -> dict:
     """The JSON object of one trial: its fit and the moment from it alone (repeatability sigma)."""
     fit = tr.fit

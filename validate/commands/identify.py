@@ -277,16 +277,11 @@ def _print(result: Measurement, label: str | None = None) -> None:
         say(f"warning: {flag}")
 
 
-SIGMA_PARTS = {"noise": "the record's noise", "law": "learning the amplitude law from the record",
-               "jackknife": "the jackknife's excess over the covariance", "envelope": "choosing the envelope's degree",
-               "near_mode": "a near mode trading with the law"}
-
-
 def sigma_parts(tr: dict) -> str:
-    """What makes the record's T0 variance (``period_std_parts``), largest first, each 1 % or more."""
-    total = tr["period_std_statistical"] ** 2
-    shares = sorted(((std**2 / total, name) for name, std in tr["period_std_parts"].items()), reverse=True)
-    said = [f"{SIGMA_PARTS[name]} {100.0 * share:.0f} %" for share, name in shares if share >= 0.01]
+    """What makes the record's T0 variance (:func:`bifilar.identification.measurement.sigma_shares`)."""
+    from bifilar.identification.measurement import sigma_shares
+
+    said = [f"{what} {100.0 * share:.0f} %" for what, share in sigma_shares(tr)]
     return f"; its variance: {', '.join(said)}" if said else ""
 
 

@@ -67,9 +67,19 @@ def trials_table(trials: list[dict]) -> Raw:
                      f"{number(tr['damping']['linear'], 3)} + {number(tr['damping']['quadratic'], 3)} |w|",
                      _law(tr["law"]), _halves(tr["halves"]),
                      number(tr["residual_rms"], 3), f"{tr['rejected']['samples']} of {tr['samples'] + tr['rejected']['samples']}",
-                     "-" if second is None else f"{number(second['period'], 4)} s"))
+                     "-" if second is None else f"{number(second['period'], 4)} s", _bound(tr)))
     return table(("trial", "record", "T0", "I", "amplitude (start -> end)", "damping", "amplitude law", "halves",
-                  "residual rms", "left out", "second mode"), rows)
+                  "residual rms", "left out", "second mode", "T0 sigma (record) / Cramér-Rao bound"), rows)
+
+
+def _bound(trial: dict) -> str:
+    """How far the record's T0 sigma is above the bound, and what makes it."""
+    from bifilar.identification.measurement import sigma_shares
+
+    if trial["crb_ratio"] is None:
+        return "-"
+    parts = "; ".join(f"{what} {100.0 * share:.0f} %" for what, share in sigma_shares(trial))
+    return f"{trial['crb_ratio']:.2f}x ({trial['crb_noise']} noise)" + (f": {parts}" if parts else "")
 
 
 def _law(law: dict) -> str:
