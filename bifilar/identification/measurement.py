@@ -362,7 +362,7 @@ def said_once(said: Sequence[tuple[str, str]]) -> list[str]:
     return [f"{', '.join(names)}: {what}" for what, names in whom.items()]
 
 
-SIGMA_PARTS = {"noise": "the record's noise", "law": "learning the amplitude law from the record",
+SIGMA_PARTS = {"noise": "the record's noise", "law": "the law's excess as the record's noise moves it",
                "jackknife": "the jackknife's excess over the covariance", "envelope": "choosing the envelope's degree",
                "near_mode": "a near mode trading with the law"}
 

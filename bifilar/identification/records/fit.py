@@ -134,8 +134,8 @@ class OscillationFit:
     or 'coloured'; :mod:`.bound`): ``period_std_statistical / crb`` is how far the fit is from efficient.
     ``period_std_parts`` says why: the standard deviations (s) whose root-sum-square is
     ``period_std_statistical``, each what one doubt adds (absent where it adds nothing): ``noise``, the
-    whole record's sandwich with the law held (the part the bound is of); ``law``, learning the amplitude
-    law (and a proportional record's scale) from the record; ``jackknife``, where the jackknife found the
+    whole record's sandwich with the law held; ``law``, what the law's excess (and a proportional record's
+    scale) carries into T0 as the record's noise moves it; ``jackknife``, where the jackknife found the
     covariance short; ``envelope``, choosing the envelope's degree; ``near_mode``, a mode near the
     torsion's frequency trading with the law.
     """
