@@ -230,6 +230,16 @@ def test_six_wire_rig_837_hangs_at_its_lowest_taut_pose():
     assert rest.com[2] <= reference[0] + 1e-7
 
 
+def test_a_start_that_diverges_is_dropped_before_lapack_sees_it(capfd):
+    """A random five-wire rig (seed 7) on which SLSQP diverges from some starts: its NaN pose went on to
+    a least squares whose LAPACK printed 'On entry to DLASCL parameter number 4 had an illegal value'
+    on the process's standard output (six times: into a --json document), then failed. The start is
+    dropped where SLSQP ends; the rig hangs as before (z of its COM the same as the other starts')."""
+    rest = rest_pose(rig_from_dict(build(7, 5, elastic=False), source="fuzz.toml"))
+    out, err = capfd.readouterr()
+    assert "DLASCL" not in out + err and rest.tensions.min() > 0.0
+
+
 def test_a_trifilar_rests_at_its_lowest_taut_pose():
     """The quick tier's case of the rigid property (one rig, not twenty): the trifilar whose two first
     starts stopped 17 mm above its lowest taut pose."""

@@ -380,6 +380,8 @@ def _search(rig: Rig, start: np.ndarray, may_slacken: bool = False) -> Rest:
         options={"ftol": 1e-12, "maxiter": 500},
     )
     x = coarse.x
+    if not np.all(np.isfinite(x)):  # SLSQP diverged from this start: nothing to polish (LAPACK prints on NaN)
+        raise FloatingPointError("SLSQP diverged")
     if may_slacken and wire_lengths(x).min() < -SLACK_GAP:
         raise RigError(rig.source, "wire", "a wire is slack at the lowest pose reached from this start")
     rotation0 = Rotation.from_rotvec(x[3:6]).as_matrix() @ rotation0
@@ -402,11 +404,9 @@ def _search(rig: Rig, start: np.ndarray, may_slacken: bool = False) -> Rest:
         rotation = Rotation.from_rotvec(sol.x[3:6]).as_matrix() @ rotation0
         rest = Rest(com=sol.x[:3].copy(), rotation=rotation, tensions=sol.x[6:] * rig.mass * rig.gravity)
     check_determinate(rig, rest.com, rest.rotation)
-    slack = np.flatnonzero(rest.tensions <= 0.0)
-    if slack.size:
-        i = int(slack[0])
-        raise RigError(rig.source, f"wire[{i + 1}]", f"would be slack at rest (tension {rest.tensions[i]:.6g} N): "
-                       "the body cannot hang taut on every wire")
+    if (slack := np.flatnonzero(rest.tensions <= 0.0)).size:
+        raise RigError(rig.source, f"wire[{slack[0] + 1}]", f"would be slack at rest (tension "
+                       f"{rest.tensions[slack[0]]:.6g} N): the body cannot hang taut on every wire")
     rest = Rest(rest.com, _nearest_on_neutral_axis(rig, rest.com, rest.rotation), rest.tensions)
     if not _stable(rig, rest):
         raise RigError(rig.source, "wire", "the only equilibrium with every wire taut found is unstable: no rest pose")
