@@ -142,9 +142,9 @@ def record_near_mode(ctx: CaseContext):
     beats over the record and the fit cannot find it apart from the first mode. The 95 % intervals
     should hold the truth in 90-98 % of them, as on any records (measured 21 of 24, rms z 1.586 on
     stop 50's code: the open part of issue 37 item 1. Its two misses, a sway 0.28 beats off and one
-    0.87 beats off under noise correlated within a cycle, gain 3-4 and -2..1 residual variances from a
-    two-mode fit even with the sway's frequency and decay held at the truth: one record cannot tell
-    them from a law; docs/identification.md "What is left")."""
+    0.87 beats off under noise correlated within a cycle, gain 0.0 and -0.7 residual variances from
+    the two-mode fit of records.near even with the sway's frequency and decay held at the truth: one
+    record cannot tell them from a law; docs/identification.md "What is left")."""
     rng = np.random.default_rng(1821)
     law = AmplitudeLaw.torsion(ROD)
     zs = []
