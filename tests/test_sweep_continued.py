@@ -76,6 +76,9 @@ def test_continued_rows_equal_general_path(name, monkeypatch, tmp_path):
                 assert fast.sigma[axis] == pytest.approx(s, rel=1e-4)
                 assert fast.dominant[axis] == general.dominant[axis]
         assert math.isnan(general.separation) or fast.separation == pytest.approx(general.separation, rel=1e-9)
+        assert fast.near.keys() == general.near.keys()
+        for axis, gap in general.near.items():  # gaps of ~1e-2 from periods equal to 1e-10
+            assert (gap is None and fast.near[axis] is None) or fast.near[axis] == pytest.approx(gap, rel=1e-7, nan_ok=True)
     # the comparison is of the continued path, not of the general one twice: every configuration
     # after the first that has a rest pose (unreachable ones have none) was continued, except on the
     # parallel rig, whose rows are neutral (its COM on the attachment line) and go the general way

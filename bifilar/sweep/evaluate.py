@@ -67,6 +67,7 @@ class Row:
     dominant: dict | None = None  # axis -> the uncertainty group with the largest share
     budget: dict | None = None  # axis -> {uncertainty group: its share of the variance}
     separation: float = math.nan  # smallest relative gap between two mode periods
+    near: dict | None = None  # axis -> relative gap in frequency from its mode to the nearest other one
     clearance: float = math.nan  # m of the lowest point above the floor (the margin is a limit)
     air_share: dict | None = None  # axis -> 1 - (T_vacuum / T)^2 of its mode: the air's part (rigs with [air])
     rest: Rest | None = None
@@ -182,6 +183,7 @@ def _continued(space: Space, rig: Rig, row: Row, guess: Rest) -> bool:
     row.periods = tuple(([float(p) for p in periods] + [None] * 4)[:4])
     row.motions = tuple(([motion_of(rig, rest, shapes[:3, k], shapes[3:, k]) for k in range(len(w2))] + [""] * 4)[:4])
     row.separation = float(np.min((periods[:-1] - periods[1:]) / periods[:-1])) if len(w2) > 1 else math.nan
+    row.near = {axis: nearest(list(periods), k) for axis, k in chosen.items()} | {a: None for a in unmeasurable}
     row.sigma, row.dominant, row.budget = {a: None for a in unmeasurable}, {a: None for a in unmeasurable}, {}
     for n, (axis, k) in enumerate(chosen.items()):
         values = inp.values.copy()
@@ -191,6 +193,14 @@ def _continued(space: Space, rig: Rig, row: Row, guess: Rest) -> bool:
                  [periods[k] for k in chosen.values()], [rot @ ident.axis_vector(a) for a in chosen], space.amplitude)
     row.tension_peak = float(np.nanmax([tensions.max(), peak]))
     return True
+
+
+def nearest(periods: list, k: int) -> float:
+    """The relative gap in frequency, |w_j / w_k - 1|, from mode ``k`` to the nearest other one of
+    ``periods`` (s; None: neutral), nan where it is alone. Under ~1.5 beats over a record such a mode
+    can hide in the amplitude law a record learns (:mod:`bifilar.identification.records.near`)."""
+    gaps = [abs(periods[k] / p - 1.0) for j, p in enumerate(periods) if j != k and p is not None]
+    return min(gaps) if gaps else math.nan
 
 
 def _record(row: Row, axis: str, spread) -> None:
@@ -211,14 +221,16 @@ def _general(space: Space, rig: Rig, row: Row, guess: Rest | None) -> None:
     row.motions = tuple(([m.motion for m in lin.modes] + [""] * 4)[:4])
     osc = sorted(p for p in row.periods if p is not None)
     row.separation = min((b - a) / b for a, b in zip(osc, osc[1:])) if len(osc) > 1 else math.nan
-    row.sigma, row.dominant, row.budget = {}, {}, {}
+    row.sigma, row.dominant, row.budget, row.near = {}, {}, {}, {}
     peaks = [float(rest.tensions.max())]
     bases = {}
     for axis in space.measure:
         p = ident.pencil(rig, axis, lin=lin)
-        if p.shares(p.moment0, p.modes(p.moment0)[1]).max() < 1e-12:  # no mode turns about the axis
-            row.sigma[axis], row.dominant[axis] = None, None
+        k, w2, v = p.associated(p.moment0)
+        if p.shares(p.moment0, v).max() < 1e-12:  # no mode turns about the axis
+            row.sigma[axis], row.dominant[axis], row.near[axis] = None, None, None
             continue
+        row.near[axis] = nearest(list(2.0 * np.pi / np.sqrt(w2)), k)
         bases[axis] = ident.predicted(rig, p)
     periods = {axis: b.period for axis, b in bases.items()}
     spreads = linear_axes(rig, periods, rig.uncertainty.period, rest, bases, lin)
@@ -248,5 +260,9 @@ def _limits(space: Space, rig: Rig, row: Row) -> None:
         problems.append(f"peak tension {row.tension_peak:.6g} N over {limits.tension:g} N")
     if limits.floor is not None and row.clearance < limits.clearance:
         problems.append(f"clearance {row.clearance:.4g} m under {limits.clearance:g} m")
+    if limits.separation is not None:
+        problems += [f"the {axis} mode {100.0 * gap:.2g} % from another mode's frequency, under "
+                     f"{100.0 * limits.separation:g} %" for axis, gap in row.near.items()
+                     if gap is not None and gap < limits.separation]
     row.feasible = not problems
     row.reason = "; ".join(problems)

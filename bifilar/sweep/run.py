@@ -91,6 +91,7 @@ def _plain(row: Row) -> dict:
         "dominant": {a: (row.dominant or {}).get(a) for a in AXES},
         "separation": num(row.separation), "clearance": num(row.clearance),
         "air_share": {a: num((row.air_share or {}).get(a)) for a in AXES},
+        "near": {a: num((row.near or {}).get(a)) for a in AXES},
     }
 
 

@@ -10,6 +10,7 @@ TOML, SI units and radians, the rig file's conventions::
     tension = 1500.0               # N per wire, at rest and in the measured motions
     floor = -6.0                   # world z of the floor, m
     clearance = 0.05               # m the body's lowest point must keep above the floor
+    separation = 0.05              # each measured mode this far in frequency from every other mode
     [measure]
     axes = ["x", "y", "z"]         # the body axes whose moments are identified
     amplitude = 0.05               # rad, the swing at which periods are timed
@@ -50,7 +51,7 @@ MAX_POINTS = 10**7  # a larger grid is a mistake: 10^7 configurations take hours
 MAX_STEPS = 10**6  # per axis
 OBJECTIVES = ("worst", "mean")
 _TOP = {"rig", "suspension", "vary", "point", "limits", "measure"}
-_LIMITS = {"tension", "floor", "clearance"}
+_LIMITS = {"tension", "floor", "clearance", "separation"}
 _MEASURE = {"axes", "amplitude", "objective"}
 _RANGE = {"from", "to", "steps", "log"}
 
@@ -60,6 +61,7 @@ class Limits:
     tension: float | None = None  # N
     floor: float | None = None  # world z, m
     clearance: float = 0.0  # m
+    separation: float | None = None  # relative gap in frequency (evaluate.nearest)
 
 
 @dataclass(frozen=True)
@@ -220,9 +222,12 @@ def load_space(path: str | Path) -> Space:
         tension=positive(lim["tension"], src, "limits.tension") if "tension" in lim else None,
         floor=number(lim["floor"], src, "limits.floor") if "floor" in lim else hall_floor,
         clearance=number(lim.get("clearance", 0.0), src, "limits.clearance"),
+        separation=positive(lim["separation"], src, "limits.separation") if "separation" in lim else None,
     )
     if limits.clearance < 0.0:
         raise RigError(src, "limits.clearance", "must be zero or more (m)")
+    if limits.separation is not None and limits.separation >= 1.0:
+        raise RigError(src, "limits.separation", f"{limits.separation:g}: a relative gap in frequency, under 1")
     meas = table(data, "measure", src, mandatory=False)
     no_unknown(meas, _MEASURE, src, "measure.")
     measured = meas.get("axes", ["x", "y", "z"])

@@ -6,7 +6,9 @@ Writes, whole or not at all, ``DIR/sweep.csv`` (one row per configuration; colum
 empty where not measured or not identifiable), ``clearance`` (m above the floor), ``feasible``, then
 ``motion_1..motion_4``, ``dominant_x..z`` (the uncertainty group with the largest share), ``separation``
 (smallest relative gap between two mode periods), ``reason`` (why a row is infeasible) and
-``air_share_x..z`` (for a rig with ``[air]``: the air's share of each measured period, 1 - (T_vacuum/T)^2)), and
+``air_share_x..z`` (for a rig with ``[air]``: the air's share of each measured period, 1 - (T_vacuum/T)^2),
+``near_x..z`` (each measured mode's relative gap in frequency to the nearest other mode: under ~1.5
+beats over a record a sway of it hides in the amplitude law; ``limits.separation`` sets a least one)), and
 ``DIR/summary.json`` (n, feasible, objective, best, pareto, seconds, mujoco_check) and ``DIR/report.html``
 (one self-contained page of them: :mod:`validate.report.sweep_page`). ``--check-mujoco K``
 runs the K best configurations in MuJoCo (:mod:`validate.studies.sweep_check`) and fails (exit 1) on a
@@ -38,7 +40,7 @@ COLUMNS_AFTER_AXES = (
     ["period_1", "period_2", "period_3", "period_4", "tension_1", "tension_2", "tension_peak",
      "sigma_x", "sigma_y", "sigma_z", "clearance", "feasible"]
     + [f"motion_{k}" for k in range(1, 5)] + ["dominant_x", "dominant_y", "dominant_z", "separation", "reason"]
-    + ["air_share_x", "air_share_y", "air_share_z"]
+    + ["air_share_x", "air_share_y", "air_share_z", "near_x", "near_y", "near_z"]
 )
 
 
@@ -75,7 +77,8 @@ def csv_row(axes: list[str], r: dict) -> list[str]:
             + [_cell(t) for t in r["tensions"]] + [_cell(r["tension_peak"])]
             + [_cell(r["sigma"][a]) for a in ("x", "y", "z")] + [_cell(r["clearance"]), _cell(r["feasible"])]
             + list(r["motions"]) + [r["dominant"][a] or "" for a in ("x", "y", "z")]
-            + [_cell(r["separation"]), r["reason"]] + [_cell(r["air_share"][a]) for a in ("x", "y", "z")])
+            + [_cell(r["separation"]), r["reason"]] + [_cell(r["air_share"][a]) for a in ("x", "y", "z")]
+            + [_cell(r["near"][a]) for a in ("x", "y", "z")])
 
 
 def _wrap(text: str) -> str:
