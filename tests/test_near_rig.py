@@ -14,7 +14,7 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 from bifilar.identification import identify as ident
-from bifilar.identification.measurement import trial_dict
+from bifilar.identification.measurement import measure, trial_dict
 from bifilar.identification.records import Record, identify_records
 from bifilar.identification.records import synthetic as Y
 from bifilar.identification.records.near import NEAR_BAND
@@ -99,3 +99,15 @@ def test_a_rig_s_own_yaw_and_sway_beating_in_its_gyro_are_flagged():
     # the mixed sway, at the moment identified (0.318: 2.8298 s; at 0.32, 2.8303 s: the crossing moves it)
     assert "2.83 s (" in flag and min(abs(t2 - 2.8303) for t2 in trial.near) < 1e-3
     assert abs(trial.moment - 0.32) < 3.0 * trial.moment_std  # 99.7 % for an honest sigma
+
+
+def test_a_period_of_a_rig_with_modes_near_the_timed_one_says_how_long_to_time():
+    """identify --period: a stopwatch period has no record to beat over, so the flag says how many cycles
+    make NEAR_BEATS beats with each near mode (1.5 / gap: 1.5 / 0.0240 = 62.6 and 1.5 / 0.0139 = 108 for
+    the tuned plate's 2.789 s yaw); the plate's own 2.006 s yaw, its sways 30 % off, gets none."""
+    tuned = ident.linear_period(ident.with_moment(PLATE, "z", TUNED), "z")
+    (flag,) = [f for f in measure(PLATE, "z", period=tuned).flags if "the rig has modes at" in f]
+    for t2 in (2.8574, 2.8281):
+        assert f"{NEAR_BEATS / abs(tuned / t2 - 1.0):.3g} cycles make 1.5 beats" in flag
+    assert "62.6 cycles" in flag and "108 cycles" in flag
+    assert not [f for f in measure(PLATE, "z", period=ident.linear_period(PLATE, "z")).flags if "the rig has" in f]

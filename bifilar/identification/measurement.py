@@ -30,7 +30,7 @@ from bifilar.rig import Rig, RigError
 from .air import added_moment, still, with_air
 from .identify import axis_vector, identify, invert_period, pencil, with_moment
 from .propagation import budget, linear_axes, monte_carlo, period_only
-from .records.pipeline import Pooled, RecordOptions, Trial, beats, identify_records
+from .records.pipeline import NEAR_BEATS, Pooled, RecordOptions, Trial, beats, identify_records, near_modes
 from .transfer import object_part, parallel_axis_moment
 
 AXIS_INDEX = {"x": 0, "y": 1, "z": 2}
@@ -237,6 +237,7 @@ def measure(rig: Rig, axis, *, period: float | None = None, amplitude: float | N
         std_source = ("the period's own sigma" if period_std is not None else
                       "the rig file's [uncertainty].period" if small_std > 0.0 else
                       "none: the rig file states no [uncertainty].period")
+        flags.extend(_near_period_flags(p, found.moment, small))
     else:
         found_trials, pooled = identify_records(rig, axis, list(signals), options, p)
         trials, ratio = tuple(found_trials), 1.0
@@ -262,6 +263,20 @@ def measure(rig: Rig, axis, *, period: float | None = None, amplitude: float | N
 
 
 _NO_BODY = "the identified tensor"  # how the flag of a tensor no body has starts
+
+
+def _near_period_flags(p, moment: float, period: float) -> list[str]:
+    """A given period's flag where the rig has modes near the one timed (:func:`.records.pipeline.near_modes`
+    at the identified ``moment``): timed over fewer cycles than make :data:`NEAR_BEATS` beats, a sway of
+    one moves the period timed, and the crossings do not show it."""
+    near = near_modes(p, moment)
+    if not near:
+        return []
+    modes = " and ".join(f"{t2:.4g} s ({100.0 * abs(period / t2 - 1.0):.2g} % off the timed one's frequency: "
+                         f"{NEAR_BEATS / abs(period / t2 - 1.0):.3g} cycles make {NEAR_BEATS:g} beats)" for t2 in near)
+    return [f"the rig has {'a mode' if len(near) == 1 else 'modes'} at {modes}: a period timed over fewer cycles "
+            "may hold a sway of it, which its crossings do not show; time that many cycles or more, repeat the "
+            "trial, or part the modes (the wires further apart or closer together)"]
 
 
 def _propagate(rig: Rig, axis, period: float, period_std: float, samples, flags: list, p,
