@@ -30,7 +30,8 @@ from bifilar.rig import Rig, RigError
 from .air import added_moment, still, with_air
 from .identify import axis_vector, identify, invert_period, pencil, with_moment
 from .propagation import budget, linear_axes, monte_carlo, period_only
-from .records.pipeline import NEAR_BEATS, Pooled, RecordOptions, Trial, beats, identify_records, near_modes
+from .records.pipeline import (NEAR_BEATS, PART_THE_MODES, Pooled, RecordOptions, Trial, beats, identify_records,
+                               near_modes, rig_has)
 from .transfer import object_part, parallel_axis_moment
 
 AXIS_INDEX = {"x": 0, "y": 1, "z": 2}
@@ -269,14 +270,12 @@ def _near_period_flags(p, moment: float, period: float) -> list[str]:
     """A given period's flag where the rig has modes near the one timed (:func:`.records.pipeline.near_modes`
     at the identified ``moment``): timed over fewer cycles than make :data:`NEAR_BEATS` beats, a sway of
     one moves the period timed, and the crossings do not show it."""
-    near = near_modes(p, moment)
+    near = [(t2, f"{NEAR_BEATS / abs(period / t2 - 1.0):.3g} cycles make {NEAR_BEATS:g} beats")
+            for t2 in near_modes(p, moment)]
     if not near:
         return []
-    modes = " and ".join(f"{t2:.4g} s ({100.0 * abs(period / t2 - 1.0):.2g} % off the timed one's frequency: "
-                         f"{NEAR_BEATS / abs(period / t2 - 1.0):.3g} cycles make {NEAR_BEATS:g} beats)" for t2 in near)
-    return [f"the rig has {'a mode' if len(near) == 1 else 'modes'} at {modes}: a period timed over fewer cycles "
-            "may hold a sway of it, which its crossings do not show; time that many cycles or more, repeat the "
-            "trial, or part the modes (the wires further apart or closer together)"]
+    return [f"{rig_has(period, near)}: a period timed over fewer cycles may hold a sway of it, which its crossings "
+            f"do not show; time that many cycles or more, repeat the trial, or {PART_THE_MODES}"]
 
 
 def _propagate(rig: Rig, axis, period: float, period_std: float, samples, flags: list, p,

@@ -64,6 +64,7 @@ HALVES_Z = 3.0  # halves further apart than this many sigmas: flagged
 SUSPECT_TORSION = 0.5 * math.pi  # a torsion beyond this is rare enough to say so (rad)
 NEAR_BEATS = 1.5  # a near mode beating fewer times than this over a record may hide in its law (.near;
 # identify-record-near-mode: sways of 1.2 beats and more were fitted or flagged, of 0.28 and 0.87 not)
+PART_THE_MODES = "part the modes (the wires further apart or closer together)"  # a near mode flag's advice
 _DEGREE = math.pi / 180.0
 # Below this amplitude (rad) the series law's O(A^4) error, ~s^2 A^4, is under 1e-6: no quintic.
 _MATCH_FROM = 0.1
@@ -407,15 +408,20 @@ def _near_flags(record: Record, fit: OscillationFit, near: tuple[float, ...]) ->
     second = fit.second_mode
     if second is not None and abs(fit.period / second[0] - 1.0) <= NEAR_BAND:
         return []
-    slow = [(t2, n) for t2 in near if (n := beats(record, fit, t2)) < NEAR_BEATS]
+    slow = [(t2, f"{n:.2g} beats over the record") for t2 in near if (n := beats(record, fit, t2)) < NEAR_BEATS]
     if not slow:
         return []
-    modes = " and ".join(f"{t2:.4g} s ({100.0 * abs(fit.period / t2 - 1.0):.2g} % off the timed one's frequency, "
-                         f"{n:.2g} beats over the record)" for t2, n in slow)
-    return [f"{file_name(record)}: the rig has {'a mode' if len(slow) == 1 else 'modes'} at {modes}: a sway beating "
-            "less than about once over a record is taken by the amplitude law, and T0's sigma may not hold it; pool "
-            "repeated trials (their laws' spread enters the sigma), time longer records, or part the modes (the wires "
-            "further apart or closer together)"]
+    return [f"{file_name(record)}: {rig_has(fit.period, slow)}: a sway beating less than about once over a record "
+            "is taken by the amplitude law, and T0's sigma may not hold it; pool repeated trials (their laws' spread "
+            f"enters the sigma), time longer records, or {PART_THE_MODES}"]
+
+
+def rig_has(period: float, near: list[tuple[float, str]]) -> str:
+    """'the rig has a mode at T2 s (x % off the timed one's frequency, <what>)', for each (T2, what) of
+    ``near`` (s; the rig's modes near the one timed, of ``period`` s): the start of a near mode's flag."""
+    modes = " and ".join(f"{t2:.4g} s ({100.0 * abs(period / t2 - 1.0):.2g} % off the timed one's frequency, {what})"
+                         for t2, what in near)
+    return f"the rig has {'a mode' if len(near) == 1 else 'modes'} at {modes}"
 
 
 def pool(trials: list[Trial]) -> Pooled:
