@@ -290,9 +290,9 @@ def _global_rest_pose(rig: Rig) -> Rest:
             numerical = numerical or exc
             retry.append(start)
     # Wires held at their lengths can leave no room to descend (six: the poses are isolated points, SLSQP
-    # only solves the length equations, to a solution near the start; issue 837: every start ended with
-    # wire 1 pushing, the lowest pose taut). From a failed start the physical problem (wires at most their
-    # lengths, tensions its multipliers, never negative) descends; the first search's reasons stand.
+    # only solves the length equations, to a solution near the start; on the random rig of seed 837 every
+    # start ended with wire 1 pushing, the lowest pose taut). From a failed start the physical problem (wires
+    # at most their lengths, tensions its multipliers, never negative) descends; the first search's reasons stand.
     for start in retry:
         try:
             found.append(_search(rig, start, may_slacken=True))
