@@ -78,8 +78,9 @@ def test_a_sway_beating_near_the_torsion_is_fitted_where_the_record_allows(monke
     # a 250 Hz gyro record of 25 cycles with a sway at 1.058 T0 (3.7 % of the swing; 1.4 beats), its
     # envelope never rising. The periodogram finds the sway (outside the band the first mode swept) but
     # fits it beside a law that took part of the beat; refitted beside the first mode in the cycles
-    # (near.near_refit) it comes out at 1.0577 T0, and T0 within its sigma (measured z -0.83, sigma
-    # 2.3e-4 s). Without the refit its decay is no one mode's (p < 1e-6): the flag says so and T0
+    # (near.near_refit) it comes out at 1.0624 T0 (1.0577 with a quadratic envelope beside it: the cubic
+    # that follows strong quadratic and dry damping takes a share of a mild record's beat, near._ENVELOPE_TWO),
+    # and T0 within its sigma (measured z +1.74, sigma 4.7e-4 s; z -0.83 and 2.3e-4 s then). Without the refit its decay is no one mode's (p < 1e-6): the flag says so and T0
     # under the ideal law is in its sigma (measured z +1.16, sigma 3.6e-3 s, 16x wider); without the
     # decay test either it was 8.1 sigma off.
     rng = np.random.default_rng(8027)
@@ -87,7 +88,7 @@ def test_a_sway_beating_near_the_torsion_is_fitted_where_the_record_allows(monke
     rec = Y.record(ROD, rng, traits)
     law = AmplitudeLaw.torsion(ROD)
     fit = fit_oscillation(rec.t, rec.y, "rate", law)
-    assert fit.second_mode[0] / rec.period == pytest.approx(traits.second[0], abs=1e-3)
+    assert fit.second_mode[0] / rec.period == pytest.approx(traits.second[0], abs=6e-3)  # a sixth of the record's resolution in frequency, 1/25
     assert not fit.law.beat and abs(fit.period - rec.period) < 1.96 * fit.period_std
     monkeypatch.setattr("bifilar.identification.records.fit.near_refit", lambda *args: args[-1])
     flagged = fit_oscillation(rec.t, rec.y, "rate", law)

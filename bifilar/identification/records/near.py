@@ -139,8 +139,15 @@ def decay_misfit(times: np.ndarray, amplitudes: np.ndarray, sd: np.ndarray, degr
 NEAR_BAND = 0.15  # a near mode is searched within this relative distance of the first mode's frequency
 NEAR_GAIN = 25.0  # the two-mode fit's chi^2 below the one-mode fit's, in its own residual variances: a mode
 _NEAR_SHARE = 0.5  # the largest near mode, relative to the first mode's swing in the record's middle
-_ENVELOPE_ONE = 6  # the one-mode fit's envelope degree (ln A): as many parameters as the two-mode fit's
-_ENVELOPE_TWO = 2  # the first mode's own envelope beside a near mode: damping's smooth decay
+_ENVELOPE_ONE = 7  # the one-mode fit's envelope degree (ln A): as many parameters as the two-mode fit's
+_ENVELOPE_TWO = 3  # the first mode's own envelope beside a near mode: damping's smooth decay, a cubic in time.
+# Viscous, quadratic and dry damping together bend ln A both ways over a record (-ln(1 + c A0 t) and
+# ln(1 - k t)), which a quadratic cannot follow, and the near mode took the bend: a gyro record from 0.63 rad
+# (quadratic 0.032, dry 1.7e-3, a sway 1.2 beats off) had it fitted 0.47 % off its frequency and T0 6.9 sigma
+# off; with the cubic, z +0.9. On 24 such records (1-2.5 beats; benchmarks/near_mode.py 53 24 damped) 23
+# intervals held the truth, rms z 1.055 (the quadratic: 21, 1.157). The cubic takes a share of a mild
+# record's beat as well: a 1.4-beat sway (tests/test_near_mode.py) is fitted 0.4 % off, its sigma 2x wider.
+# Choosing the degree by an F test at 1 % fixed neither (the bend and the beat overlap in the cycles' fit)
 _RATIO_DEGREE = 6  # R(A)'s polynomial in A^2 (_Near)
 _SUBSTEPS = 4  # the law's phase integral's steps a cycle (trapezoid: ~1e-4 of the law's ~1e-2 a cycle)
 
@@ -149,7 +156,7 @@ def near_mode_of(cyc: Cycles, law_fit: PhaseFit, rate: bool, prior: float) -> Se
     """A second mode within :data:`NEAR_BAND` of the torsion's frequency, fitted to the cycles' complex
     fundamentals z_k = a_k e^(i phi_k) (:mod:`.cycles`: a window one local period long takes all of a
     near mode into its fundamental, times sinc((omega2 - omega_k) / omega_k)) as the sum of the first
-    mode, e^(P(t) + i Phi(t)) with ln A = P a quadratic (damping's smooth decay) and
+    mode, e^(P(t) + i Phi(t)) with ln A = P a cubic (damping's smooth decay) and
     Phi = phi0 + omega0 int dt / (R(A) E(A)) (the ideal law R, its excess E = 1 + ds A^2 + dq A^4 under
     its ``prior``, A in rad: a rate's fundamental over omega0), and a damped sinusoid
     C e^((-decay + i omega2) t). Against it one mode alone with an envelope of degree
