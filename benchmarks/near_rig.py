@@ -9,10 +9,11 @@ left unflagged cover.
 
     PYTHONPATH=. python benchmarks/near_rig.py SEED COUNT
 
-Seed 3711, 32 records (stop 52), before the cubic envelope of :mod:`bifilar.identification.records.near`:
-"inside 27 of 32 rms z 2.065"; all three misses under 1.5 beats flagged (z +3.73, +3.59, -5.75), two
-unflagged: a sway 1.23 beats off under strong quadratic and dry damping fitted 0.47 % off its frequency
-(z +6.92), and one whose miss its traits give without the sway too (z -3.32 at 2.55 beats).
+Seed 3711, 32 records (stop 52): "inside 27 of 32 rms z 1.774"; 15 flagged, among them all four misses
+under 1.5 beats (z +3.73, -2.27, +3.59, -5.75); the 17 unflagged at rms z 1.16, their one miss (z -3.74,
+2.55 beats) a record whose traits miss without the sway as well. Before the cubic envelope of
+:mod:`bifilar.identification.records.near`: "inside 27 of 32 rms z 2.065", a sway 1.23 beats off under
+strong quadratic and dry damping fitted 0.47 % off its frequency and left unflagged (z +6.92).
 """
 
 import math
