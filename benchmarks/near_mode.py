@@ -11,8 +11,9 @@ found (its period, size, decay; None: none, or refused inside the band the first
 0.5-0.8 rad under strong quadratic (0.025-0.04) and dry (1-3e-3) damping, a sway 4-10 % off the
 torsion's frequency (1-2.5 beats over the record) of 5-10 % of the swing. Seed 53, 24 records: "inside
 21 of 24 rms z 1.157" with the near-mode fit's first-mode envelope a quadratic in time, "inside 23 of
-24 rms z 1.055" with a cubic (:data:`bifilar.identification.records.near._ENVELOPE_TWO`); choosing between
-the two by an F test at 1 % "inside 22 of 24 rms z 1.257".
+24 rms z 1.055" with a cubic, "inside 22 of 24 rms z 1.257" choosing between the two by an F test at 1 %,
+"inside 24 of 24 rms z 0.822" with the damping law's decay
+(:data:`bifilar.identification.records.near._ENVELOPE_TWO`, stop 52).
 
 Measured (seed 7, 30 records, before issue 37 item 1's change): rms z 2.41; every |z| > 2.5 had its
 sway at 0.96-0.99 omega0 (under 1 beat over the record, inside the swept band) with sigma ~3e-4 and

@@ -9,11 +9,12 @@ left unflagged cover.
 
     PYTHONPATH=. python benchmarks/near_rig.py SEED COUNT
 
-Seed 3711, 32 records (stop 52): "inside 27 of 32 rms z 1.774"; 15 flagged, among them all four misses
-under 1.5 beats (z +3.73, -2.27, +3.59, -5.75); the 17 unflagged at rms z 1.16, their one miss (z -3.74,
-2.55 beats) a record whose traits miss without the sway as well. Before the cubic envelope of
-:mod:`bifilar.identification.records.near`: "inside 27 of 32 rms z 2.065", a sway 1.23 beats off under
-strong quadratic and dry damping fitted 0.47 % off its frequency and left unflagged (z +6.92).
+Seed 3711, 32 records (stop 52): "inside 28 of 32 rms z 1.728"; 14 flagged, among them all three misses
+under 1.5 beats (z +3.73, +3.59, -5.75); the 18 unflagged at rms z 1.13, their one miss (z -3.79, 2.55
+beats) a record whose traits miss without the sway as well (six draws without it: rms z 1.65). With
+the first mode's envelope beside a near mode a quadratic in time (:mod:`bifilar.identification.records.near`,
+stop 50): "inside 27 of 32 rms z 2.065", a sway 1.23 beats off under strong quadratic and dry damping
+fitted 0.47 % off its frequency and left unflagged (z +6.92); a cubic: "inside 27 of 32 rms z 1.774".
 """
 
 import math

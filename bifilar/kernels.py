@@ -58,6 +58,7 @@ GROUPS = {
         "peak_tension": "a1 a2 a2 a1 a1 a1 a2 a2 a2 f f a1"}, 4.6),
     "tmt": Group("bifilar.seeds.tmt", {"_kinematics": "a1 a1 a2 a2 i1 a1 i1 i"}, 3.3),
     "damping": Group("bifilar.identification.records.damping", {"_cycle_from": "f f f f f"}, 0.7),
+    "near": Group("bifilar.identification.records.near", {"_damping_decay": "a1 f f f f"}, 4.4),
     "modes": Group("bifilar.motion.modes", {"resolution": "f f f"}, 0.1),
 }
 

@@ -132,10 +132,13 @@ def test_a_long_clean_record_has_no_second_mode_and_no_bias():
 def test_the_ideal_law_alone_is_biased_and_the_learned_one_is_not():
     """A record whose real law is 30 % stronger: held at the ideal law (--law-sigma 0) its T0 is off by
     more than 3 of its sigmas (the cycles' sandwich widens with the misfit: 3.8 here) and by 2e-3 of
-    T0; learning the excess puts it within 3 sigmas and cuts the error at least threefold."""
+    T0; learning the excess puts it within 3 sigmas and cuts the error at least threefold. The held fit
+    searches no second mode: with the first mode's envelope its damping's decay (records.near), the
+    near-mode search takes the held law's misfit for a mode beside the torsion (its doubt 1.1e-3 s, z 2.8),
+    which is not what this test is about."""
     rec = Y.record(ROD, np.random.default_rng(4), Y.Traits(amplitude=0.6, cycles=80, excess=0.3, quadratic=0.01,
                                                             white=0.003))
-    held = fit_oscillation(rec.t, rec.y, "angle", ROD_LAW, excess_prior=0.0)
+    held = fit_oscillation(rec.t, rec.y, "angle", ROD_LAW, excess_prior=0.0, second_mode=False)
     learned = fit_oscillation(rec.t, rec.y, "angle", ROD_LAW)
     assert abs(held.period - rec.period) > 3.0 * held.period_std
     assert abs(learned.period - rec.period) < 3.0 * learned.period_std

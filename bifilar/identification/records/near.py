@@ -10,7 +10,7 @@ and where it finds the sway just outside that band it fits it beside the law as 
 law that took part of the beat. To first order in its size a beat is an amplitude law whose frequency
 moves with ln A at the beat frequency: a law free to move takes it, and extrapolates it into T0.
 
-:func:`near_mode_of` fits the cycles' complex fundamentals as the first mode (its own smooth envelope,
+:func:`near_mode_of` fits the cycles' complex fundamentals as the first mode (its own damping's decay,
 the ideal law's phase with the excess under its prior) plus a damped sinusoid within
 :data:`NEAR_BAND`, against one mode with an envelope free to follow the wobble: the law, held to its
 prior, cannot follow the phase's. Where the two modes fit better by :data:`NEAR_GAIN` of their own
@@ -41,6 +41,7 @@ from __future__ import annotations
 
 import math
 
+import numba as nb
 import numpy as np
 from scipy.integrate import cumulative_trapezoid
 from scipy.optimize import least_squares
@@ -140,14 +141,15 @@ NEAR_BAND = 0.15  # a near mode is searched within this relative distance of the
 NEAR_GAIN = 25.0  # the two-mode fit's chi^2 below the one-mode fit's, in its own residual variances: a mode
 _NEAR_SHARE = 0.5  # the largest near mode, relative to the first mode's swing in the record's middle
 _ENVELOPE_ONE = 7  # the one-mode fit's envelope degree (ln A): as many parameters as the two-mode fit's
-_ENVELOPE_TWO = 3  # the first mode's own envelope beside a near mode: damping's smooth decay, a cubic in time.
-# Viscous, quadratic and dry damping together bend ln A both ways over a record (-ln(1 + c A0 t) and
-# ln(1 - k t)), which a quadratic cannot follow, and the near mode took the bend: a gyro record from 0.63 rad
-# (quadratic 0.032, dry 1.7e-3, a sway 1.2 beats off) had it fitted 0.47 % off its frequency and T0 6.9 sigma
-# off; with the cubic, z +0.9. On 24 such records (1-2.5 beats; benchmarks/near_mode.py 53 24 damped) 23
-# intervals held the truth, rms z 1.055 (the quadratic: 21, 1.157). The cubic takes a share of a mild
-# record's beat as well: a 1.4-beat sway (tests/test_near_mode.py) is fitted 0.4 % off, its sigma 2x wider.
-# Choosing the degree by an F test at 1 % fixed neither (the bend and the beat overlap in the cycles' fit)
+DAMPING = -1  # the first mode's own envelope beside a near mode: a damping law's decay (:func:`_damping_decay`)
+_ENVELOPE_TWO = DAMPING  # Viscous, quadratic and dry damping together bend ln A both ways over a record
+# (-ln(1 + c A0 t), ln(1 - k t)), which a quadratic in time (stop 50) cannot follow: the near mode took the
+# bend. A gyro record of a tuned bench plate from 0.63 rad (quadratic 0.032, dry 1.7e-3, a sway 1.2 beats off)
+# had its sway fitted 0.47 % off and T0 6.9 sigma off; six draws of its traits: rms z 3.9 with the quadratic,
+# 0.55 with the damping law. On 24 such records at 1-2.5 beats (benchmarks/near_mode.py 53 24 damped): 21
+# inside, rms z 1.157 with the quadratic; 23, 1.055 with a cubic, which also takes a share of a mild record's
+# beat (tests/test_near_mode.py's 1.4-beat sway 0.4 % off, z +1.74); 24, 0.822 with the damping law, which
+# follows the bend and not the beat (that sway 0.1 % off, z +0.16)
 _RATIO_DEGREE = 6  # R(A)'s polynomial in A^2 (_Near)
 _SUBSTEPS = 4  # the law's phase integral's steps a cycle (trapezoid: ~1e-4 of the law's ~1e-2 a cycle)
 
@@ -156,7 +158,7 @@ def near_mode_of(cyc: Cycles, law_fit: PhaseFit, rate: bool, prior: float) -> Se
     """A second mode within :data:`NEAR_BAND` of the torsion's frequency, fitted to the cycles' complex
     fundamentals z_k = a_k e^(i phi_k) (:mod:`.cycles`: a window one local period long takes all of a
     near mode into its fundamental, times sinc((omega2 - omega_k) / omega_k)) as the sum of the first
-    mode, e^(P(t) + i Phi(t)) with ln A = P a cubic (damping's smooth decay) and
+    mode, e^(P(t) + i Phi(t)) with ln A = P the decay of linear, quadratic and dry damping and
     Phi = phi0 + omega0 int dt / (R(A) E(A)) (the ideal law R, its excess E = 1 + ds A^2 + dq A^4 under
     its ``prior``, A in rad: a rate's fundamental over omega0), and a damped sinusoid
     C e^((-decay + i omega2) t). Against it one mode alone with an envelope of degree
@@ -219,8 +221,8 @@ def near_refit(cyc: Cycles, law_fit: PhaseFit, rate: bool, prior: float, second:
 
 class _Near:
     """The cycles' complex fundamentals and the one- and two-mode models of :func:`near_mode_of`:
-    p = (phi0, omega0, ln A's Chebyshev terms, the excess's two terms in prior sigmas[, omega2, decay,
-    Re C, Im C]), times from the record's middle."""
+    p = (phi0, omega0, ln A's terms (:meth:`envelope`), the excess's two terms in prior sigmas[, omega2,
+    decay, Re C, Im C]), times from the record's middle."""
 
     @classmethod
     def of(cls, cyc: Cycles, law_fit: PhaseFit, rate: bool, prior: float, add: Second | None = None) -> _Near | None:
@@ -256,6 +258,7 @@ class _Near:
         # the law's phase integral, trapezoid, over _SUBSTEPS steps between neighbouring cycles
         self.grid = np.interp(np.arange((len(t) - 1) * _SUBSTEPS + 1) / _SUBSTEPS, np.arange(len(t)), t)
         self._bases = {}
+        self._decay = None
 
     def basis(self, degree: int) -> tuple[np.ndarray, np.ndarray]:
         """The Chebyshev basis of ln A at the grid and at the cycles."""
@@ -267,17 +270,34 @@ class _Near:
     def dof(self, sol) -> int:
         return max(2 * len(self.t) + 2 - len(sol.x), 1)
 
-    def law_phase(self, omega0: float, envelope: np.ndarray, excess: np.ndarray, derivatives: bool = False):
+    def envelope(self, coef: np.ndarray, degree: int, derivatives: bool = False):
+        """The first mode's ln A on the grid and at the cycles (and with ``derivatives`` their derivatives by
+        its terms ``coef``, columns): a Chebyshev series of ``degree`` in time, or with :data:`DAMPING` the
+        decay d ln A / dt = -(a + b A + c / A) of linear, quadratic and dry damping from ln A at the
+        record's start (``coef`` = (ln A0, a, b, c), :func:`_damping_decay`). The cycles lie on the grid,
+        every :data:`_SUBSTEPS` steps."""
+        if degree == DAMPING:
+            key = tuple(float(x) for x in coef)
+            if self._decay is None or self._decay[0] != key:  # the model asks twice a step: the law's phase too
+                self._decay = key, _damping_decay(self.grid, *key)
+            grid, slope = self._decay[1]
+            return (grid, grid[::_SUBSTEPS], slope, slope[::_SUBSTEPS]) if derivatives else (grid, grid[::_SUBSTEPS])
+        grid_basis, at_cycles = self.basis(degree)
+        values = grid_basis @ coef, at_cycles @ coef
+        return (*values, grid_basis, at_cycles) if derivatives else values
+
+    def law_phase(self, omega0: float, envelope: np.ndarray, degree: int, excess: np.ndarray,
+                  derivatives: bool = False):
         """int_middle^t dt / (R(A) E(A)) (s) at the cycles, and with ``derivatives`` its derivatives by
-        omega0, by ln A's Chebyshev terms (columns) and by the excess's two terms (columns): the ideal
+        omega0, by ln A's terms (columns, :meth:`envelope`) and by the excess's two terms (columns): the ideal
         law R (none where the swing in rad is not known), A the first mode's own peak swing (rad: a
         rate's fundamental over omega0), E = 1 + width (e1 A^2 + e2 A^4)."""
         n, k = len(self.t), len(envelope)
         if self.table is None:
             law = self.t - self.middle
             return (law, np.zeros(n), np.zeros((n, k)), np.zeros((n, 2))) if derivatives else law
-        grid_basis = self.basis(k - 1)[0]
-        a = np.exp(grid_basis @ envelope) / (omega0 if self.rate else 1.0)
+        log_a, _, grid_slope, _ = self.envelope(envelope, degree, derivatives=True)
+        a = np.exp(log_a) / (omega0 if self.rate else 1.0)
         inside = a < self.table.largest  # past it the table's last value is held: no derivative
         a2 = np.minimum(a, self.table.largest) ** 2
         ratio = self.ratio(a2)
@@ -289,7 +309,7 @@ class _Near:
         slope = np.where(inside, -rate * (self.ratio_slope(a2) / ratio
                                           + self.width * (excess[0] + 2.0 * excess[1] * a2) / excess_factor), 0.0)
         columns = np.column_stack([slope * -2.0 * a2 / omega0 if self.rate else np.zeros_like(a2),
-                                   (slope * 2.0 * a2)[:, None] * grid_basis,
+                                   (slope * 2.0 * a2)[:, None] * grid_slope,
                                    -rate * self.width * a2 / excess_factor,
                                    -rate * self.width * a2 * a2 / excess_factor])
         q = self._integral(np.column_stack([rate, columns]))
@@ -305,15 +325,16 @@ class _Near:
 
     def model(self, p: np.ndarray, degree: int, second: bool, derivatives: bool = False):
         """The complex fundamental at the cycles (and, with ``derivatives``, its derivatives by p, columns)."""
-        envelope = p[2:3 + degree]
+        k = _terms(degree)
+        envelope = p[2:2 + k]
         u = self.t - self.middle
-        at_cycles = self.basis(degree)[1]
-        law = self.law_phase(p[1], envelope, p[3 + degree:5 + degree], derivatives)
+        _, log_a, _, at_cycles = self.envelope(envelope, degree, derivatives=True)
+        law = self.law_phase(p[1], envelope, degree, p[2 + k:4 + k], derivatives)
         law, by_omega, by_envelope, by_excess = law if derivatives else (law, None, None, None)
-        z1 = np.exp(at_cycles @ envelope + 1j * (p[0] + p[1] * law))
+        z1 = np.exp(log_a + 1j * (p[0] + p[1] * law))
         z = z1
         if second:
-            omega2, decay, cr, ci = p[5 + degree:9 + degree]
+            omega2, decay, cr, ci = p[4 + k:8 + k]
             x = (omega2 - self.omega) / self.omega
             ramp = np.exp((-decay + 1j * omega2) * u)
             shape = ramp * np.sinc(x)
@@ -333,14 +354,15 @@ class _Near:
 
     def residual(self, p: np.ndarray, degree: int, second: bool) -> np.ndarray:
         q = self.z / self.model(p, degree, second)
-        return np.concatenate([np.angle(q) / self.sd_phase, np.log(np.abs(q)) / self.sd_log, p[3 + degree:5 + degree]])
+        k = _terms(degree)
+        return np.concatenate([np.angle(q) / self.sd_phase, np.log(np.abs(q)) / self.sd_log, p[2 + k:4 + k]])
 
     def jacobian(self, p: np.ndarray, degree: int, second: bool) -> np.ndarray:
         """d residual / d p: the model's log derivative, its imaginary part the phase's, its real part ln A's."""
         z, dz = self.model(p, degree, second, derivatives=True)
         log_slope = dz / z[:, None]
         prior = np.zeros((2, len(p)))
-        prior[0, 3 + degree] = prior[1, 4 + degree] = 1.0
+        prior[0, 2 + _terms(degree)] = prior[1, 3 + _terms(degree)] = 1.0
         return np.vstack([-log_slope.imag / self.sd_phase[:, None], -log_slope.real / self.sd_log[:, None], prior])
 
     def fit(self, degree: int, start: np.ndarray | None = None):
@@ -349,11 +371,17 @@ class _Near:
         second = start is not None
         if start is None:
             u = self.t - self.middle
-            envelope = np.polynomial.chebyshev.chebfit(u / self.half, self.log_a, degree)
+            if degree == DAMPING:  # all linear damping, at the decay's mean rate
+                slope, middle = np.polyfit(u, self.log_a, 1)
+                envelope = np.array([middle + slope * (self.t[0] - self.middle), max(-slope, 0.0), 0.0, 0.0])
+            else:
+                envelope = np.polynomial.chebyshev.chebfit(u / self.half, self.log_a, degree)
             w0 = np.polyfit(u, self.phase, 1)[0]
-            omega0, phi0 = np.polyfit(self.law_phase(w0, envelope, np.zeros(2)), self.phase, 1)
+            omega0, phi0 = np.polyfit(self.law_phase(w0, envelope, degree, np.zeros(2)), self.phase, 1)
             start = np.concatenate([[phi0, omega0], envelope, [0.0, 0.0]])
         lo, hi = np.full(len(start), -np.inf), np.full(len(start), np.inf)
+        if degree == DAMPING:  # damping only takes the swing: a, b, c >= 0
+            lo[3:6] = 0.0
         if second:  # a mode beating in lasts the record (:func:`.second_mode.second_mode_of`)
             lo[-3], hi[-3] = 0.0, SECOND_DECAY_SPANS / (2.0 * self.half)
         start = np.clip(start, lo, hi)
@@ -364,7 +392,8 @@ class _Near:
         """The near mode of the two-mode fit ``two`` (its amplitude at tau = 0), None where it is past
         :data:`_NEAR_SHARE` of the first mode's swing in the record's middle, below :data:`NEAR_FLOOR` of
         it, or outside :data:`NEAR_BAND`."""
-        first = math.exp(float(np.polynomial.chebyshev.chebval(0.0, two.x[2:3 + _ENVELOPE_TWO])))
+        log_a = self.envelope(two.x[2:2 + _terms(_ENVELOPE_TWO)], _ENVELOPE_TWO)[0]
+        first = math.exp(float(np.interp(self.middle, self.grid, log_a)))
         omega2, decay, c = float(two.x[-4]), float(two.x[-3]), complex(two.x[-2], two.x[-1])
         if not NEAR_FLOOR * first <= abs(c) <= _NEAR_SHARE * first or abs(omega2 / two.x[1] - 1.0) > NEAR_BAND:
             return None
@@ -408,3 +437,57 @@ class _Near:
             c = np.sum(weight * rest * np.exp(-1j * (omega2 - p[1]) * u)) / np.sum(weight) * np.exp(1j * p[0])
             out.append(np.concatenate([p, [omega2, 0.1 / (2.0 * self.half), c.real, c.imag]]))
         return out
+
+
+def _terms(degree: int) -> int:
+    """The first mode's envelope's terms of :meth:`_Near.envelope` for ``degree``."""
+    return 4 if degree == DAMPING else degree + 1
+
+
+_LOG_A_SPAN = 10.0  # ln A is held within this of its start in :func:`_damping_decay` (a swing falling
+# 2e4-fold over a record: none the fit measures), its derivatives 0 there: a trial step of the search may
+# ask for a decay that ends the swing, where dry friction's c / A, and the sensitivities, grow without bound
+
+
+@nb.njit(cache=True)
+def _damping_decay(grid, log_a0, a, b, c):
+    """ln A at ``grid`` (s, increasing) from ``log_a0`` at its start under d ln A / dt = -(a + b A + c / A)
+    (linear, quadratic and dry damping of the swing A), and its derivatives by (ln A0, a, b, c), columns:
+    RK4 between the grid's points with the sensitivities' equations alongside (~1e-4 of a cycle's decay
+    a step at :data:`_SUBSTEPS` steps a cycle, as the law's phase integral)."""
+    n = len(grid)
+    out = np.empty(n)
+    slope = np.zeros((n, 4))
+    v = log_a0
+    s = np.array([1.0, 0.0, 0.0, 0.0])
+    out[0] = v
+    slope[0] = s
+    low, high = log_a0 - _LOG_A_SPAN, log_a0 + _LOG_A_SPAN
+    for k in range(n - 1):
+        h = grid[k + 1] - grid[k]
+        kv = np.empty(4)
+        ks = np.empty((4, 4))
+        vi, si = v, s.copy()
+        for stage in range(4):
+            e = math.exp(min(max(vi, low), high))
+            kv[stage] = -(a + b * e + c / e)
+            ks[stage, 0] = 0.0
+            ks[stage, 1] = -1.0
+            ks[stage, 2] = -e
+            ks[stage, 3] = -1.0 / e
+            for j in range(4):
+                ks[stage, j] += -(b * e - c / e) * si[j]
+            if stage < 3:
+                step = h if stage == 2 else 0.5 * h
+                vi = v + step * kv[stage]
+                for j in range(4):
+                    si[j] = s[j] + step * ks[stage, j]
+        v = v + h * (kv[0] + 2.0 * kv[1] + 2.0 * kv[2] + kv[3]) / 6.0
+        for j in range(4):
+            s[j] = s[j] + h * (ks[0, j] + 2.0 * ks[1, j] + 2.0 * ks[2, j] + ks[3, j]) / 6.0
+        if not low < v < high or not np.all(np.isfinite(s)):  # held at the bound: no derivative there
+            v = min(max(v, low), high) if math.isfinite(v) else low
+            s[:] = 0.0
+        out[k + 1] = v
+        slope[k + 1] = s
+    return out, slope
