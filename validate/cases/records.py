@@ -140,10 +140,10 @@ def record_near_mode(ctx: CaseContext):
     """24 gyro records of the rod (the identify-record-trials traits: 25 cycles at 250 Hz) with a sway
     within 10 % of the torsion's frequency, 2-10 % of the swing: within ~5 % it is less than ~1.5
     beats over the record and the fit cannot find it apart from the first mode. The 95 % intervals
-    should hold the truth in 90-98 % of them, as on any records (measured 22 of 24, rms z 1.411 on
-    stop 52's code, the near mode's first-mode envelope a cubic; 21, 1.586 with a quadratic. Its two
-    misses, a sway 0.28 beats off (z +5.7) and one 0.87 beats off under noise correlated within a cycle
-    (+3.1), gain 0.0 and -0.7 residual variances from the two-mode fit of records.near even with the
+    should hold the truth in 90-98 % of them, as on any records (measured 22 of 24, rms z 1.447 on
+    stop 52's code, the first mode's envelope beside a near mode its damping's decay: the case fails;
+    21, 1.586 on stop 50's. Its two misses, a sway 0.28 beats off (z +5.7) and one 0.87 beats off under
+    noise correlated within a cycle (+3.1), give rms z 1.33 by themselves; they gain 0.0 and -0.7 residual variances from the two-mode fit of records.near even with the
     sway's frequency and decay held at the truth: one record cannot tell them from a law; where the
     sway is the rig's own mode, identify flags such a record from the rig file, benchmarks/near_rig.py;
     docs/identification.md "What is left")."""
