@@ -76,7 +76,7 @@ from .bounds import Deadline, binned
 from .clean import Rejected, spans, stuck
 from .cycles import Cycles, Samples, baseline_of, measure, rough_frequency
 from .law import EXCESS_PRIOR, LINEAR, AmplitudeLaw
-from .near import NEAR_BAND, near_doubt, near_mode_of, near_refit
+from .near import NEAR_BAND, near_doubt, near_held, near_mode_of, near_refit
 from .phase_fit import EXCESS_TERMS, PhaseFit
 from .phase_law import LAW_CONFLICT, Model, pendulum, swing_of, unwrap
 from .read import KINDS, MIN_CYCLES, MIN_SAMPLES
@@ -137,7 +137,8 @@ class OscillationFit:
     whole record's sandwich with the law held; ``law``, what the law's excess (and a proportional record's
     scale) carries into T0 as the record's noise moves it; ``jackknife``, where the jackknife found the
     covariance short; ``envelope``, choosing the envelope's degree; ``near_mode``, a mode near the
-    torsion's frequency trading with the law.
+    torsion's frequency trading with the law. ``near_held``: the second mode is one of ``near_periods``
+    fitted at its given frequency (:func:`.near.near_held`), not one the record showed.
     """
 
     period: float
@@ -171,15 +172,20 @@ class OscillationFit:
     crb: float = math.nan  # s, the Cramér-Rao bound's sigma of T0 (:mod:`.bound`)
     crb_noise: str = ""  # the noise the bound assumed: 'white' or 'coloured'
     period_std_parts: dict = field(default_factory=dict)  # s, what makes period_std_statistical (its docstring)
+    near_held: bool = False  # the second mode is the rig's near mode at its frequency (near_periods), not found
 
 
 def fit_oscillation(t, y, kind: str, law: AmplitudeLaw = LINEAR, *, excess_prior: float = EXCESS_PRIOR,
                     scale: float | None = None, max_amplitude: float | None = None,
-                    second_mode: bool = True, deadline: Deadline | None = None) -> OscillationFit:
+                    second_mode: bool = True, near_periods: tuple[float, ...] = (),
+                    deadline: Deadline | None = None) -> OscillationFit:
     """Fit the module's model to samples ``y`` at increasing times ``t`` (s).
 
     ``excess_prior``: the prior std of ds / s and dq / s (0: the ideal law exactly). ``scale`` and
-    ``max_amplitude``: what is known of a proportional record's scale (module docstring). A dense record
+    ``max_amplitude``: what is known of a proportional record's scale (module docstring). ``near_periods``
+    (s): the rig's modes near the torsion's frequency that the record may not show by their beat; where
+    the record shows none, a mode at the nearest-fitting of them is fitted beside the torsion at that
+    frequency whatever its size, and its doubt carried into the sigma (:func:`.near.near_held`). A dense record
     is fitted in bins (:func:`.bounds.binned`). Raises ValueError naming what is wrong with a record that
     cannot be used, :class:`.bounds.WorkSpent` once ``deadline`` is spent.
     """
@@ -222,6 +228,9 @@ def fit_oscillation(t, y, kind: str, law: AmplitudeLaw = LINEAR, *, excess_prior
     near = None
     if second_mode and second is None:
         near = near_mode_of(cyc, phase, rec.kind == "rate", model.prior)
+        if near is None and near_periods:
+            near = near_held(cyc, phase, rec.kind == "rate", model.prior,
+                             tuple(2.0 * math.pi / p for p in near_periods))
     elif second is not None and abs(second.omega / phase.omega0 - 1.0) <= NEAR_BAND:
         near = near_refit(cyc, phase, rec.kind == "rate", model.prior, second)
     if near is not None:  # a mode near the torsion's frequency, found by its beat: subtracted, the law refitted
@@ -370,7 +379,8 @@ def _result(rec: Samples, t: np.ndarray, cyc: Cycles, model: Model, phase: Phase
         block=whole.block, jackknife=groups, samples=int(kept.sum()), cycles=int(good.sum()), cycle_time=t[0] + centre,
         cycle_period=per_cycle, cycle_amplitude=cycle_amp, law_curve=curve, t=t, y=rec.y, fitted=fitted, kept=kept,
         binned=rec.binned, crb=to_period * math.sqrt(whole.bound.variance), crb_noise=whole.bound.noise,
-        period_std_parts={k: math.sqrt(v) for k, v in parts.items() if v > 1e-9 * std_stat**2})  # not rounding
+        period_std_parts={k: math.sqrt(v) for k, v in parts.items() if v > 1e-9 * std_stat**2},  # not rounding
+        near_held=second is not None and second.held)
 
 
 def _law_curve(model: Model, phase: PhaseFit, period: float, amplitude: np.ndarray):

@@ -188,10 +188,29 @@ def near_doubt(cyc: Cycles, law_fit: PhaseFit, rate: bool, prior: float, second:
         return 0.0
     two = data.from_second(second)
     scale = max(2.0 * two.cost / data.dof(two), 1.0)
-    jac = two.jac
+    jac = np.delete(two.jac, -4, axis=1) if second.held else two.jac  # the rig's frequency: held
     free = np.linalg.pinv(jac.T @ jac)[1, 1]
     held = np.linalg.pinv(jac[:, :-4].T @ jac[:, :-4])[1, 1]
     return min(scale * max(free - held, 0.0), data.reach(two.x) ** 2)
+
+
+def near_held(cyc: Cycles, law_fit: PhaseFit, rate: bool, prior: float, omegas: tuple[float, ...]) -> Second | None:
+    """A mode at one of the rig's frequencies ``omegas`` (rad/s) within :data:`NEAR_BAND` of the
+    torsion's, fitted beside the first mode in the cycles' two-mode model of :func:`near_mode_of` with
+    its frequency held there: the best of them, whatever its size (the rig says where it is, so no search
+    asks the gain of :data:`NEAR_GAIN`, and a size the record cannot tell from 0 carries its doubt,
+    :func:`near_doubt`). None where the cycles are too few, no frequency lies within the band, or the
+    mode is past :data:`_NEAR_SHARE` of the first."""
+    data = _Near.of(cyc, law_fit, rate, prior)
+    if data is None:
+        return None
+    base = data.fit(_ENVELOPE_TWO)
+    near = [w for w in omegas if abs(w / base.x[1] - 1.0) <= NEAR_BAND]
+    if not near:
+        return None
+    best = min((data.fit(_ENVELOPE_TWO, start, held=True) for start in data.starts(base, near)),
+               key=lambda sol: sol.cost)
+    return data.mode_of(best, held=True)
 
 
 def near_refit(cyc: Cycles, law_fit: PhaseFit, rate: bool, prior: float, second: Second) -> Second | None:
@@ -352,9 +371,21 @@ class _Near:
         prior[0, 2 + _terms(degree)] = prior[1, 3 + _terms(degree)] = 1.0
         return np.vstack([-log_slope.imag / self.sd_phase[:, None], -log_slope.real / self.sd_log[:, None], prior])
 
-    def fit(self, degree: int, start: np.ndarray | None = None):
+    def fit(self, degree: int, start: np.ndarray | None = None, held: bool = False):
         """The least squares of one mode (``start`` None: from the envelope's and the phase's linear
-        fits) or of two (from ``start``)."""
+        fits) or of two (from ``start``; ``held``: the second's frequency held at its start)."""
+        if held:
+            omega2, j = start[-4], len(start) - 4
+
+            def whole(q):
+                return np.insert(q, j, omega2)
+
+            lo, hi = self._bounds(np.delete(start, j), degree, True)
+            sol = least_squares(lambda q: self.residual(whole(q), degree, True), np.clip(np.delete(start, j), lo, hi),
+                                jac=lambda q: np.delete(self.jacobian(whole(q), degree, True), j, axis=1),
+                                bounds=(lo, hi), x_scale="jac", ftol=1e-6, xtol=1e-6)
+            sol.x, sol.jac = whole(sol.x), self.jacobian(whole(sol.x), degree, True)
+            return sol
         second = start is not None
         if start is None:
             u = self.t - self.middle
@@ -366,14 +397,20 @@ class _Near:
             w0 = np.polyfit(u, self.phase, 1)[0]
             omega0, phi0 = np.polyfit(self.law_phase(w0, envelope, degree, np.zeros(2)), self.phase, 1)
             start = np.concatenate([[phi0, omega0], envelope, [0.0, 0.0]])
-        lo, hi = np.full(len(start), -np.inf), np.full(len(start), np.inf)
-        if degree == DAMPING:  # damping only takes the swing: a, b, c >= 0
-            lo[3:6] = 0.0
-        if second:  # a mode beating in lasts the record (:func:`.second_mode.second_mode_of`)
-            lo[-3], hi[-3] = 0.0, SECOND_DECAY_SPANS / (2.0 * self.half)
+        lo, hi = self._bounds(start, degree, second)
         start = np.clip(start, lo, hi)
         return least_squares(self.residual, start, jac=self.jacobian, args=(degree, second), bounds=(lo, hi),
                              x_scale="jac", ftol=1e-6, xtol=1e-6)
+
+    def _bounds(self, start: np.ndarray, degree: int, second: bool):
+        """Damping only takes the swing (a, b, c >= 0); a mode beating in lasts the record
+        (:func:`.second_mode.second_mode_of`): its decay is p[-3]."""
+        lo, hi = np.full(len(start), -np.inf), np.full(len(start), np.inf)
+        if degree == DAMPING:
+            lo[3:6] = 0.0
+        if second:
+            lo[-3], hi[-3] = 0.0, SECOND_DECAY_SPANS / (2.0 * self.half)
+        return lo, hi
 
     def reach(self, p: np.ndarray) -> float:
         """The most the near mode of the two-mode fit ``p`` can move omega0 (rad/s): the sum's frequency
@@ -391,17 +428,18 @@ class _Near:
             law = 2.0 * abs(float(self.ratio(a2)) * (1.0 + self.width * (p[2 + k] * a2 + p[3 + k] * a2 * a2)) - 1.0)
         return abs(omega0) * eps / (1.0 - eps) * (abs(omega2 / omega0 - 1.0) + law)
 
-    def mode_of(self, two) -> Second | None:
+    def mode_of(self, two, held: bool = False) -> Second | None:
         """The near mode of the two-mode fit ``two`` (its amplitude at tau = 0), None where it is past
         :data:`_NEAR_SHARE` of the first mode's swing in the record's middle, below :data:`NEAR_FLOOR` of
         it, or outside :data:`NEAR_BAND`."""
         log_a = self.envelope(two.x[2:2 + _terms(_ENVELOPE_TWO)], _ENVELOPE_TWO)[0]
         first = math.exp(float(np.interp(self.middle, self.grid, log_a)))
         omega2, decay, c = float(two.x[-4]), float(two.x[-3]), complex(two.x[-2], two.x[-1])
-        if not NEAR_FLOOR * first <= abs(c) <= _NEAR_SHARE * first or abs(omega2 / two.x[1] - 1.0) > NEAR_BAND:
+        floor = 0.0 if held else NEAR_FLOOR
+        if not floor * first <= abs(c) <= _NEAR_SHARE * first or abs(omega2 / two.x[1] - 1.0) > NEAR_BAND:
             return None
         c = c * np.exp((decay - 1j * omega2) * self.middle)
-        return Second(omega2, decay, float(c.real), float(-c.imag), near=True)
+        return Second(omega2, decay, float(c.real), float(-c.imag), near=True, held=held)
 
     def from_second(self, second: Second, mirror: bool = False):
         """The two-mode fit started from the one-mode fit and ``second``; with ``mirror``, the better of
@@ -413,7 +451,7 @@ class _Near:
         starts = [np.concatenate([base.x, [second.omega, second.decay, c.real, c.imag]])]
         if mirror:
             starts += self.starts(base, [2.0 * base.x[1] - second.omega])
-        return min((self.fit(_ENVELOPE_TWO, start) for start in starts), key=lambda sol: sol.cost)
+        return min((self.fit(_ENVELOPE_TWO, start, second.held) for start in starts), key=lambda sol: sol.cost)
 
     def starts(self, base, picked: list[float] | None = None) -> list[np.ndarray]:
         """Two-mode starts from the one-mode fit ``base`` at the frequencies ``picked`` (None: the three

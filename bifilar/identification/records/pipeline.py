@@ -214,16 +214,22 @@ def _trial(record: Record, target: Target, options: RecordOptions, deadline: Dea
     if not law.same_as(target.ideal):
         fit = _fit(record, law, options, deadline)
     found = _invert(target, fit, record)
+    slow = _slow_near(record, fit, found.near)
+    if slow:  # the rig's mode the record cannot show by its beat: fitted at the rig's frequency (.near.near_held)
+        fit = _fit(record, law, options, deadline, slow)
+        found = _invert(target, fit, record)
     split = halves(record, law, options, deadline)
     std = abs(found.value * fit.period_std / fit.period / found.sensitivity)
     flags = _flags(record, fit, split, options) + _near_flags(record, fit, found.near)
     return Trial(record, fit, split, found.value, std, found.sensitivity, tuple(flags), found.near)
 
 
-def _fit(record: Record, law: AmplitudeLaw, options: RecordOptions, deadline: Deadline | None = None) -> OscillationFit:
+def _fit(record: Record, law: AmplitudeLaw, options: RecordOptions, deadline: Deadline | None = None,
+         near: tuple[float, ...] = ()) -> OscillationFit:
     try:
         return fit_oscillation(record.t, record.y, record.kind, law, excess_prior=options.law_sigma,
-                               scale=options.amplitude_scale, max_amplitude=options.max_amplitude, deadline=deadline)
+                               scale=options.amplitude_scale, max_amplitude=options.max_amplitude,
+                               near_periods=near, deadline=deadline)
     except SwingError as exc:
         raise RigError(record.source, record.column, swing_problem(record, exc.swing, law, options)) from None
     except LawBandError as exc:
@@ -401,19 +407,34 @@ def beats(record: Record, fit: OscillationFit, period: float) -> float:
     return float(record.t[-1] - record.t[0]) * abs(1.0 / period - 1.0 / fit.period)
 
 
+def _slow_near(record: Record, fit: OscillationFit, near: tuple[float, ...]) -> tuple[float, ...]:
+    """The rig's modes near the one timed (s, :func:`near_modes`) that beat fewer than :data:`NEAR_BEATS`
+    times over the record, where the fit kept no mode near the torsion's frequency found by the record
+    itself (one held at the rig's frequency, :func:`.near.near_held`, is not)."""
+    second = fit.second_mode
+    if second is not None and abs(fit.period / second[0] - 1.0) <= NEAR_BAND and not fit.near_held:
+        return ()
+    return tuple(t2 for t2 in near if beats(record, fit, t2) < NEAR_BEATS)
+
+
 def _near_flags(record: Record, fit: OscillationFit, near: tuple[float, ...]) -> list[str]:
     """A flag naming the rig's modes near the one timed (:func:`near_modes`) that beat fewer than
     :data:`NEAR_BEATS` times over the record, where the fit kept no mode near the torsion's frequency
-    (one it kept, its trade with the law is in the sigma: :func:`.near.near_doubt`)."""
-    second = fit.second_mode
-    if second is not None and abs(fit.period / second[0] - 1.0) <= NEAR_BAND:
-        return []
-    slow = [(t2, f"{n:.2g} beats over the record") for t2 in near if (n := beats(record, fit, t2)) < NEAR_BEATS]
+    that the record showed: where one was fitted at the rig's frequency (:func:`.near.near_held`) its
+    doubt is in the sigma, and the flag says how large the sigma is; where none could be, T0's sigma
+    may not hold it. (A mode the record showed: its trade with the law is in the sigma,
+    :func:`.near.near_doubt`, and no flag.)"""
+    slow = _slow_near(record, fit, near)
     if not slow:
         return []
-    return [f"{file_name(record)}: {rig_has(fit.period, slow)}: a sway beating less than about once over a record "
-            "is taken by the amplitude law, and T0's sigma may not hold it; pool repeated trials (their laws' spread "
-            f"enters the sigma), time longer records, or {PART_THE_MODES}"]
+    modes = rig_has(fit.period, [(t2, f"{beats(record, fit, t2):.2g} beats over the record") for t2 in slow])
+    if fit.near_held:
+        return [f"{file_name(record)}: {modes}: too few beats to tell its size from the amplitude law's, so it is "
+                "fitted beside the torsion at the rig's frequency and what it may do to T0 is in the sigma "
+                f"({100.0 * fit.period_std / fit.period:.2g} % of T0); time longer records or {PART_THE_MODES}"]
+    return [f"{file_name(record)}: {modes}: a sway beating less than about once over a record is taken by the "
+            "amplitude law, and T0's sigma may not hold it; pool repeated trials (their laws' spread enters the "
+            f"sigma), time longer records, or {PART_THE_MODES}"]
 
 
 def rig_has(period: float, near: list[tuple[float, str]]) -> str:

@@ -86,6 +86,7 @@ class Second:
     c: float
     s: float
     near: bool = False
+    held: bool = False  # its frequency the rig's (.near.near_held), not fitted
 
     def signal(self, tau):
         return np.exp(-self.decay * tau) * (self.c * np.cos(self.omega * tau) + self.s * np.sin(self.omega * tau))

@@ -113,7 +113,7 @@ def fit_whole(rec: Samples, cyc: Cycles, law_fit: PhaseFit, baseline: np.ndarray
     refined = None
     if second is not None:
         c2, s2 = beta[-2:]
-        refined = Second(float(q[4]), float(q[5]), float(c2), float(s2), second.near)
+        refined = Second(float(q[4]), float(q[5]), float(c2), float(s2), second.near, second.held)
     # the law's parameters, held here, in the bound with their priors: the fundamental's response to them
     # (the harmonics' and a rate's envelope's, a few % of it, left out)
     law = (np.exp(q[2] + q[3] * u) * envelope * np.sin(q[0] + q[1] * integral))[:, None] * q[1] \
@@ -129,10 +129,13 @@ def _whole_fit(tau, y, u, integral, envelope, level, harmonics, first, second):
     residual, linear terms, model)."""
     start = list(first)
     omega0 = start[1]
+    held = second is not None and second.held  # the rig's frequency (.near.near_held): not a parameter
     if second is not None:
         start += [second.omega, second.decay]
 
     def design(q):
+        if held:
+            q = np.insert(q, 4, second.omega)
         phase = q[0] + q[1] * integral
         env = np.exp(q[2] + q[3] * u) * envelope
         cols = [np.ones_like(u), u]
@@ -155,9 +158,13 @@ def _whole_fit(tau, y, u, integral, envelope, level, harmonics, first, second):
     if second is not None:  # a mode beating in lasts the record (:func:`second_mode_of`)
         lo[5], hi[5] = 0.0, SECOND_DECAY_SPANS / max(tau[-1] - tau[0], 1e-300)
     start = np.clip(np.array(start, dtype=float), lo, hi)
+    if held:
+        start, lo, hi = (np.delete(v, 4) for v in (start, lo, hi))
     sol = least_squares(residual, start, bounds=(lo, hi), x_scale="jac", xtol=1e-12, ftol=1e-12, gtol=1e-12)
     q = sol.x
     fixed, x = design(q)
+    if held:
+        q = np.insert(q, 4, second.omega)
     beta = np.linalg.lstsq(x, y - fixed, rcond=None)[0]
     model_y = fixed + x @ beta
     return q, np.column_stack([sol.jac, -x]), y - model_y, beta, model_y
