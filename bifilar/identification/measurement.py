@@ -378,7 +378,8 @@ def said_once(said: Sequence[tuple[str, str]]) -> list[str]:
 
 SIGMA_PARTS = {"noise": "the record's noise", "law": "the law's excess as the record's noise moves it",
                "jackknife": "the jackknife's excess over the covariance", "envelope": "choosing the envelope's degree",
-               "near_mode": "a near mode trading with the law"}
+               "near_mode": "a near mode trading with the law",
+               "rig_mode": "what the rig's near mode, fitted at its frequency, moves T0"}
 
 
 def sigma_shares(trial: dict) -> list[tuple[str, float]]:

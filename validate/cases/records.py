@@ -165,9 +165,9 @@ def record_near_mode(ctx: CaseContext):
     that sway beating in (:func:`near_rig_records`), identified as a lab would, with the rig file: the
     95 % intervals of the moment hold the truth in 90-98 % of them, as on any records. Under ~1.5 beats
     over the record a sway is not told from the amplitude law by the record alone (records.near); the
-    rig says where it lies, and the fit puts a mode there whatever its size, its doubt in the sigma
-    (records.near.near_held; measured 24 of 24, rms z 0.743 on stop 53's code; 20 of 24, 2.139 on
-    stop 52's, which only flagged such records). Before stop 53 this case fitted records of the rod with a sway at
+    rig says where it lies, and how far a mode fitted there moves T0 enters the sigma
+    (records.pipeline._with_rig_mode; measured 23 of 24, rms z 0.885 on stop 53's code; 20 of 24,
+    2.139 on stop 52's, which only flagged such records). Before stop 53 this case fitted records of the rod with a sway at
     0.9-1.1 T0 that was no mode of any rig, without one: 22 of 24, rms z 1.449, its misses the sways
     under a beat that one record cannot tell from a law (benchmarks/near_mode.py measures that still;
     docs/identification.md, "What is left")."""

@@ -137,7 +137,9 @@ class OscillationFit:
     whole record's sandwich with the law held; ``law``, what the law's excess (and a proportional record's
     scale) carries into T0 as the record's noise moves it; ``jackknife``, where the jackknife found the
     covariance short; ``envelope``, choosing the envelope's degree; ``near_mode``, a mode near the
-    torsion's frequency trading with the law. ``near_held``: the second mode is one of ``near_periods``
+    torsion's frequency trading with the law; ``rig_mode``, what the rig's near mode the record does not
+    show moves T0 when fitted at its frequency (``rig_mode_shift``, added by
+    :func:`.pipeline.identify_records`). ``near_held``: the second mode is one of ``near_periods``
     fitted at its given frequency (:func:`.near.near_held`), not one the record showed.
     """
 
@@ -173,6 +175,7 @@ class OscillationFit:
     crb_noise: str = ""  # the noise the bound assumed: 'white' or 'coloured'
     period_std_parts: dict = field(default_factory=dict)  # s, what makes period_std_statistical (its docstring)
     near_held: bool = False  # the second mode is the rig's near mode at its frequency (near_periods), not found
+    rig_mode_shift: float = 0.0  # s, T0 moved by the rig's near mode fitted at its frequency, in period_std
 
 
 def fit_oscillation(t, y, kind: str, law: AmplitudeLaw = LINEAR, *, excess_prior: float = EXCESS_PRIOR,

@@ -15,7 +15,9 @@
 5. invert the zero-amplitude period into the moment (:func:`bifilar.identification.identify.invert_period`),
    and list the rig's other modes within :data:`.near.NEAR_BAND` of the timed one's frequency there
    (:func:`near_modes`): a sway of one of them that beats less than :data:`NEAR_BEATS` times over the
-   record is, in one record, taken by the amplitude law (:mod:`.near`), so the record is flagged;
+   record is, in one record, taken by the amplitude law (:mod:`.near`), so where the record showed no
+   mode near the torsion it is fitted again with a mode at the rig's frequency, how far that moves T0
+   enters the sigma (:func:`_with_rig_mode`), and the record is flagged;
 6. fit each half of the record alone: their agreement is the record's own test of its sigma (``halves``);
 7. pool the trials (:func:`pool`): the records of one rig share its amplitude law, so the part of each
    sigma that is the law's prior is common to all of them (a full covariance, not independent noise).
@@ -33,7 +35,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from scipy.optimize import brentq
@@ -215,13 +217,28 @@ def _trial(record: Record, target: Target, options: RecordOptions, deadline: Dea
         fit = _fit(record, law, options, deadline)
     found = _invert(target, fit, record)
     slow = _slow_near(record, fit, found.near)
-    if slow:  # the rig's mode the record cannot show by its beat: fitted at the rig's frequency (.near.near_held)
-        fit = _fit(record, law, options, deadline, slow)
-        found = _invert(target, fit, record)
+    if slow:  # the rig's mode the record cannot show by its beat: what fitting it at its frequency moves T0
+        held = _fit(record, law, options, deadline, slow)
+        if held.near_held:
+            fit = _with_rig_mode(fit, held)
+            found = _invert(target, fit, record)
     split = halves(record, law, options, deadline)
     std = abs(found.value * fit.period_std / fit.period / found.sensitivity)
     flags = _flags(record, fit, split, options) + _near_flags(record, fit, found.near)
     return Trial(record, fit, split, found.value, std, found.sensitivity, tuple(flags), found.near)
+
+
+def _with_rig_mode(fit: OscillationFit, held: OscillationFit) -> OscillationFit:
+    """``fit`` with what fitting the rig's near mode at its frequency (``held``, :func:`.near.near_held`)
+    moves T0 in its sigma: under the beats a record cannot show, the mode's size is not told from the
+    law's (module docstring of :mod:`.near`), so the fit with it is no better an estimate (its sigma
+    ~2-10x wider, its T0 moved by a phantom where the record holds no sway), but how far it moves T0 is
+    how far a sway of the rig's may have moved the fit without it."""
+    shift = held.period - fit.period
+    parts = {**fit.period_std_parts, "rig_mode": abs(shift)}
+    return replace(fit, period_std=math.hypot(fit.period_std, shift),
+                   period_std_statistical=math.hypot(fit.period_std_statistical, shift), period_std_parts=parts,
+                   rig_mode_shift=shift)
 
 
 def _fit(record: Record, law: AmplitudeLaw, options: RecordOptions, deadline: Deadline | None = None,
@@ -412,7 +429,7 @@ def _slow_near(record: Record, fit: OscillationFit, near: tuple[float, ...]) -> 
     times over the record, where the fit kept no mode near the torsion's frequency found by the record
     itself (one held at the rig's frequency, :func:`.near.near_held`, is not)."""
     second = fit.second_mode
-    if second is not None and abs(fit.period / second[0] - 1.0) <= NEAR_BAND and not fit.near_held:
+    if second is not None and abs(fit.period / second[0] - 1.0) <= NEAR_BAND:
         return ()
     return tuple(t2 for t2 in near if beats(record, fit, t2) < NEAR_BEATS)
 
@@ -428,9 +445,9 @@ def _near_flags(record: Record, fit: OscillationFit, near: tuple[float, ...]) ->
     if not slow:
         return []
     modes = rig_has(fit.period, [(t2, f"{beats(record, fit, t2):.2g} beats over the record") for t2 in slow])
-    if fit.near_held:
-        return [f"{file_name(record)}: {modes}: too few beats to tell its size from the amplitude law's, so it is "
-                "fitted beside the torsion at the rig's frequency and what it may do to T0 is in the sigma "
+    if fit.rig_mode_shift:
+        return [f"{file_name(record)}: {modes}: too few beats to tell its size from the amplitude law's; fitted at "
+                f"the rig's frequency it moves T0 by {fit.rig_mode_shift:+.2g} s, which is in the sigma "
                 f"({100.0 * fit.period_std / fit.period:.2g} % of T0); time longer records or {PART_THE_MODES}"]
     return [f"{file_name(record)}: {modes}: a sway beating less than about once over a record is taken by the "
             "amplitude law, and T0's sigma may not hold it; pool repeated trials (their laws' spread enters the "
