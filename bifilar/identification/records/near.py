@@ -33,8 +33,10 @@ exponentials of their own rates and wobble at their beat: :func:`decay_misfit`),
 law past its prior. And a rig has one law: records of it, or a record's two halves, each learn the
 beat their own sway's phase and size ask for; where the excesses they learned disagree beyond their
 sigmas, :func:`.pipeline._own_variances` measures their spread and carries it into each one's T0, in
-the halves' test and in pooled trials. A sway under a beat that neither shows stays open (issue 37
-item 1; docs/identification.md, "What is left").
+the halves' test and in pooled trials. Where the sway is one of the rig's own modes the rig file says
+where it lies: :func:`near_held` fits a mode there whatever its size, and the pipeline carries how far
+that moves T0 into the sigma (:func:`.pipeline._with_rig_mode`). A sway under a beat that no record of
+it shows and no rig places stays open (issue 37 item 1; docs/identification.md, "What is left").
 """
 
 from __future__ import annotations
