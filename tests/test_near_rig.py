@@ -19,12 +19,14 @@ from scipy.spatial.transform import Rotation
 from bifilar.identification import identify as ident
 from bifilar.identification.measurement import measure, trial_dict
 from bifilar.identification.records import AmplitudeLaw, Record, fit_oscillation, identify_records
+from bifilar.identification.records import pipeline
 from bifilar.identification.records import synthetic as Y
 from bifilar.identification.records.near import NEAR_BAND
 from bifilar.identification.records.pipeline import NEAR_BEATS, near_modes
 from bifilar.motion import lagrange as L
 from bifilar.motion.kane import KaneModel
 from bifilar.motion.simulate import simulate
+from bifilar.rig import RigError
 from bifilar.rig.statics import State, rest_pose, taut_shift
 from validate import cli
 from validate.assets import rig
@@ -91,6 +93,23 @@ def test_what_the_rig_s_hidden_mode_moves_t0_is_in_the_sigma():
         (flag,) = [f for f in trial.flags if "at the rig's frequency" in f]
         assert flag.startswith("log.csv: the rig has mode") and f"moves T0 by {shift:+.2g} s" in flag
         assert f"({100.0 * trial.fit.period_std / trial.fit.period:.2g} % of T0)" in flag
+
+
+def test_a_record_whose_refit_with_the_rig_s_mode_fails_keeps_its_fit_and_flag(monkeypatch):
+    """The refit with the rig's mode is a second opinion: if it raises, the record keeps its own fit
+    and the flag that its sigma may not hold the sway (none of the rig's mode's part in it)."""
+    fit = pipeline._fit
+
+    def failing(record, law, options, deadline=None, near=()):
+        if near:
+            raise RigError(record.source, record.column, "a refit that fails")
+        return fit(record, law, options, deadline)
+
+    monkeypatch.setattr(pipeline, "_fit", failing)
+    rec = list(near_rig_records(np.random.default_rng(3711), 26))[25][3]
+    (trial,), _ = identify_records(PLATE, "z", [Record("log.csv", "gyro_z", "rate", rec.t, rec.y)])
+    assert trial.fit.rig_mode_shift == 0.0 and "rig_mode" not in trial.fit.period_std_parts
+    assert any("T0's sigma may not hold it" in f for f in trial.flags)
 
 
 @pytest.mark.slow

@@ -218,8 +218,11 @@ def _trial(record: Record, target: Target, options: RecordOptions, deadline: Dea
     found = _invert(target, fit, record)
     slow = _slow_near(record, fit, found.near)
     if slow:  # the rig's mode the record cannot show by its beat: what fitting it at its frequency moves T0
-        held = _fit(record, law, options, deadline, slow)
-        if held.near_held:
+        try:
+            held = _fit(record, law, options, deadline, slow)
+        except RigError:  # the record fitted without the mode: it keeps the flag that its sigma may not hold it
+            held = None
+        if held is not None and held.near_held:
             fit = _with_rig_mode(fit, held)
             found = _invert(target, fit, record)
     split = halves(record, law, options, deadline)
