@@ -53,7 +53,8 @@ def main(seed: int, count: int, with_sway: bool) -> None:
         print(f"{i:2d} I {moment:.3f} sway/T0 {sway / period:.4f} beats {beats:.2f} share {rec.traits.second[1]:.3f} "
               f"z {z:+.2f} sigma {trial.moment_std / moment:.1e} "
               f"fitted {None if second is None else round(second[0] / trial.fit.period, 4)} "
-              f"{'shift %+.1e ' % trial.fit.rig_mode_shift if trial.fit.rig_mode_shift else ''}flagged {flagged}", flush=True)
+              f"{f'shift {trial.fit.rig_mode_shift:+.1e} ' if trial.fit.rig_mode_shift else ''}"
+              f"flagged {flagged}", flush=True)
     zs = np.array(zs)
     print("inside", int(np.sum(np.abs(zs) <= 1.96)), "of", count, "rms z %.3f" % math.sqrt(float(np.mean(zs**2))),
           "rms error %.2e" % math.sqrt(float(np.mean(np.square(errors)))))

@@ -155,7 +155,8 @@ def near_rig_records(rng: np.random.Generator, count: int, sway: bool = True):
         traits = Y.gyro(rng, rate=250.0, cycles=25.0)
         share = rng.uniform(0.02, 0.1)  # drawn either way: the same records with and without the sway
         traits = replace(traits, second=(period / periods[k], share if sway else 0.0, traits.second[2]))
-        yield moment, period, float(periods[k]), Y.record(L.from_rig(ident.with_moment(plate, "z", moment)), rng, traits)
+        truth = L.from_rig(ident.with_moment(plate, "z", moment))
+        yield moment, period, float(periods[k]), Y.record(truth, rng, traits)
 
 
 @case("identify-record-near-mode", source="issue 37 item 1 (a sway near the torsion)", engines=("analytic",),
@@ -167,10 +168,10 @@ def record_near_mode(ctx: CaseContext):
     over the record a sway is not told from the amplitude law by the record alone (records.near); the
     rig says where it lies, and how far a mode fitted there moves T0 enters the sigma
     (records.pipeline._with_rig_mode; measured 23 of 24, rms z 0.885 on stop 53's code; 20 of 24,
-    2.139 on stop 52's, which only flagged such records). Before stop 53 this case fitted records of the rod with a sway at
-    0.9-1.1 T0 that was no mode of any rig, without one: 22 of 24, rms z 1.449, its misses the sways
-    under a beat that one record cannot tell from a law (benchmarks/near_mode.py measures that still;
-    docs/identification.md, "What is left")."""
+    2.139 on stop 52's, which only flagged such records). Before stop 53 this case fitted records of
+    the rod with a sway at 0.9-1.1 T0 that was no mode of any rig, without one: 22 of 24, rms z 1.449,
+    its misses the sways under a beat that one record cannot tell from a law (benchmarks/near_mode.py
+    measures that still; docs/identification.md, "What is left")."""
     plate = rig("bench_plate")
     zs = []
     for moment, _, _, rec in near_rig_records(np.random.default_rng(1821), 24):

@@ -433,7 +433,8 @@ class _Near:
     def mode_of(self, two, held: bool = False) -> Second | None:
         """The near mode of the two-mode fit ``two`` (its amplitude at tau = 0), None where it is past
         :data:`_NEAR_SHARE` of the first mode's swing in the record's middle, below :data:`NEAR_FLOOR` of
-        it, or outside :data:`NEAR_BAND`."""
+        it (not with ``held``: a mode the rig places has no floor, :func:`near_held`), or outside
+        :data:`NEAR_BAND`."""
         log_a = self.envelope(two.x[2:2 + _terms(_ENVELOPE_TWO)], _ENVELOPE_TWO)[0]
         first = math.exp(float(np.interp(self.middle, self.grid, log_a)))
         omega2, decay, c = float(two.x[-4]), float(two.x[-3]), complex(two.x[-2], two.x[-1])

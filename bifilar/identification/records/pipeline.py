@@ -429,8 +429,8 @@ def beats(record: Record, fit: OscillationFit, period: float) -> float:
 
 def _slow_near(record: Record, fit: OscillationFit, near: tuple[float, ...]) -> tuple[float, ...]:
     """The rig's modes near the one timed (s, :func:`near_modes`) that beat fewer than :data:`NEAR_BEATS`
-    times over the record, where the fit kept no mode near the torsion's frequency found by the record
-    itself (one held at the rig's frequency, :func:`.near.near_held`, is not)."""
+    times over the record, where the fit kept no mode near the torsion's frequency (a mode the record
+    showed: its trade with the law is in the sigma, :func:`.near.near_doubt`)."""
     second = fit.second_mode
     if second is not None and abs(fit.period / second[0] - 1.0) <= NEAR_BAND:
         return ()
@@ -439,11 +439,9 @@ def _slow_near(record: Record, fit: OscillationFit, near: tuple[float, ...]) -> 
 
 def _near_flags(record: Record, fit: OscillationFit, near: tuple[float, ...]) -> list[str]:
     """A flag naming the rig's modes near the one timed (:func:`near_modes`) that beat fewer than
-    :data:`NEAR_BEATS` times over the record, where the fit kept no mode near the torsion's frequency
-    that the record showed: where one was fitted at the rig's frequency (:func:`.near.near_held`) its
-    doubt is in the sigma, and the flag says how large the sigma is; where none could be, T0's sigma
-    may not hold it. (A mode the record showed: its trade with the law is in the sigma,
-    :func:`.near.near_doubt`, and no flag.)"""
+    :data:`NEAR_BEATS` times over the record (:func:`_slow_near`): where a refit with one of them at its
+    frequency moved T0 (:func:`_with_rig_mode`) the flag quotes the move and the sigma that holds it;
+    where no such refit could be made, T0's sigma may not hold the sway."""
     slow = _slow_near(record, fit, near)
     if not slow:
         return []
